@@ -1,0 +1,44 @@
+"""jaxcelt: a differentiable, vmappable JAX simulator of the rattleback (Celtic stone) on a
+horizontally vibrating base, with the coupled dry-friction / rolling-resistance contact model
+of Awrejcewicz & Kudra (2014). See MODEL.md for the equations.
+
+Importing jaxcelt enables float64 in JAX (``jax_enable_x64``).
+"""
+
+from . import _config  # noqa: F401  (float64 on)
+from .contact import CONTACT_LAWS, AbstractContactLaw, GeneralisedPade, get_contact_law
+from .diagnostics import Diagnostics, centre_position, diagnostics, energy, tilt
+from .elliptic import contact_integrals, ellipke
+from .model import STATE_NAMES, kinematics, normal_force, vector_field
+from .params import PARAM_NAMES, CeltParams
+from .solve import INVALID_KINDS, STATUS, Solution, simulate
+from .state import check_state, constraint_residual, initial_state
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "AbstractContactLaw",
+    "CONTACT_LAWS",
+    "CeltParams",
+    "Diagnostics",
+    "GeneralisedPade",
+    "INVALID_KINDS",
+    "PARAM_NAMES",
+    "STATE_NAMES",
+    "STATUS",
+    "Solution",
+    "centre_position",
+    "check_state",
+    "constraint_residual",
+    "contact_integrals",
+    "diagnostics",
+    "ellipke",
+    "energy",
+    "get_contact_law",
+    "initial_state",
+    "kinematics",
+    "normal_force",
+    "simulate",
+    "tilt",
+    "vector_field",
+]

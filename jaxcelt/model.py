@@ -1,0 +1,215 @@
+"""The wobblestone on a vibrating base: the pure right-hand side, built from small stages.
+
+Stages (each a pure function of one sample; batch with ``jax.vmap``), MODEL.md sections:
+
+1. `contact_geometry`  -- contact point r(n) and its rate (eqs. 3-4; section 3)
+2. `horizontal_frame`  -- global axes E1, E2 in body components from (n, psi) (eq. 6; section 4)
+3. `patch_frame`       -- contact-patch axes e_x, e_y (Fig. 2; section 5)
+4. `kinematics`        -- slip, spin and rolling velocities (eqs. 2, 16, 17; section 6)
+5. contact law         -- loads per unit N (`jaxcelt.contact`; section 7)
+6. `normal_force`      -- N from the differentiated constraint d/dt(v_A . n) = 0 (section 8)
+7. `vector_field`      -- Newton-Euler, n_dot, r_C dot, psi dot (eqs. 1, 5, 6; section 8)
+
+State y = (v[3], omega[3], n[3], r_C[3], psi), 13 numbers, SI units; v, omega, n in body
+components, r_C in global components.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import jax.numpy as jnp
+
+from ._types import Array, Scalar, ScalarLike, State, Vec3
+from .contact import AbstractContactLaw, ContactKinematics, ContactLoads, get_contact_law
+from .params import CeltParams
+
+__all__ = [
+    "Frame",
+    "Geometry",
+    "Kinematics",
+    "contact_geometry",
+    "horizontal_frame",
+    "patch_frame",
+    "kinematics",
+    "contact_loads",
+    "normal_force",
+    "normal_force_parts",
+    "vector_field",
+    "split_state",
+    "STATE_NAMES",
+]
+
+STATE_NAMES: tuple[str, ...] = (
+    "v1", "v2", "v3", "omega1", "omega2", "omega3", "n1", "n2", "n3", "rC1", "rC2", "rC3", "psi",
+)  # fmt: skip
+
+
+def split_state(y: State) -> tuple[Vec3, Vec3, Vec3, Vec3, Scalar]:
+    """(v, omega, n, r_C, psi) from the 13-vector."""
+    return y[0:3], y[3:6], y[6:9], y[9:12], y[12]
+
+
+class Geometry(NamedTuple):
+    """Contact geometry (eqs. 3-4): r = O->A, rho = C->A, their rates, n_dot; body comps [m, m/s]."""
+
+    r: Vec3
+    rho: Vec3
+    r_dot: Vec3
+    n_dot: Vec3
+
+
+def contact_geometry(n: Vec3, omega: Vec3, p: CeltParams) -> Geometry:
+    """Contact point of the ellipsoid with the plane of normal n, and its body-frame rate.
+
+    s = sqrt(n^T A n), r = -A n / s, with A = diag(a1^2, a2^2, a3^2) (eq. 4, MODEL.md A2);
+    n_dot = -omega x n (eq. 1); r_dot = -(A n_dot)/s + (n^T A n_dot) A n / s^3 (n . r_dot = 0).
+    """
+    A = jnp.stack([p.a1, p.a2, p.a3]) ** 2
+    An = A * n
+    s = jnp.sqrt(jnp.dot(n, An))
+    r = -An / s
+    n_dot = -jnp.cross(omega, n)
+    A_ndot = A * n_dot
+    r_dot = -A_ndot / s + jnp.dot(n, A_ndot) * An / s**3
+    return Geometry(r=r, rho=r - jnp.stack([p.k1, p.k2, p.k3]), r_dot=r_dot, n_dot=n_dot)
+
+
+class Frame(NamedTuple):
+    """Global horizontal axes E1, E2 (E3 = n) in body components; R = [E1; E2; n] maps body->global."""
+
+    E1: Vec3
+    E2: Vec3
+
+    def to_global(self, x: Vec3, n: Vec3) -> Vec3:
+        return jnp.stack([jnp.dot(self.E1, x), jnp.dot(self.E2, x), jnp.dot(n, x)])
+
+
+def horizontal_frame(n: Vec3, psi: ScalarLike) -> Frame:
+    """E1, E2 from n and the precession angle psi (Z-X-Y sequence; MODEL.md section 4).
+
+    u = (e2 - n2 n)/sqrt(1 - n2^2), w = u x n, E1 = cos(psi) w - sin(psi) u,
+    E2 = sin(psi) w + cos(psi) u. Singular only when body x2 is vertical (n2 = +-1).
+    """
+    e2 = jnp.array([0.0, 1.0, 0.0], dtype=n.dtype)
+    u = (e2 - n[1] * n) / jnp.sqrt(1.0 - n[1] ** 2)
+    w = jnp.cross(u, n)
+    c, s = jnp.cos(psi), jnp.sin(psi)
+    return Frame(E1=c * w - s * u, E2=s * w + c * u)
+
+
+def patch_frame(n: Vec3) -> tuple[Vec3, Vec3]:
+    """Contact-patch axes (Fig. 2; MODEL.md section 5, A6).
+
+    e_x = (e1 - n1 n)/sqrt(1 - n1^2) (long body axis projected on the base), e_y = n x e_x.
+    """
+    e1 = jnp.array([1.0, 0.0, 0.0], dtype=n.dtype)
+    e_x = (e1 - n[0] * n) / jnp.sqrt(1.0 - n[0] ** 2)
+    return e_x, jnp.cross(n, e_x)
+
+
+def base_velocity(t: ScalarLike, frame: Frame, p: CeltParams) -> Vec3:
+    """v_pi = s_pi q_pi omega_pi sin(omega_pi t) E1 in body components [m/s] (eq. 17, A12)."""
+    return p.v_pi_sign * p.q_pi * p.omega_pi * jnp.sin(p.omega_pi * t) * frame.E1
+
+
+class Kinematics(NamedTuple):
+    """Everything the contact law and the balance laws need at one state."""
+
+    v: Vec3
+    omega: Vec3
+    n: Vec3
+    geom: Geometry
+    frame: Frame
+    e_x: Vec3
+    e_y: Vec3
+    v_A: Vec3
+    """absolute velocity of the body point at A [m/s]"""
+    contact: ContactKinematics
+    """non-dimensional slip/spin/rolling [1/s]"""
+
+
+def kinematics(t: ScalarLike, y: State, p: CeltParams) -> Kinematics:
+    """Relative velocities at the contact (eqs. 2, 16; MODEL.md section 6).
+
+    v_A = v + omega x rho; v_s = (v_A - v_pi)/a_hat; omega_s = omega . n;
+    v_r = v_s + r_dot/a_hat; x/y components on the patch axes.
+    """
+    v, omega, n, _, psi = split_state(y)
+    geom = contact_geometry(n, omega, p)
+    frame = horizontal_frame(n, psi)
+    e_x, e_y = patch_frame(n)
+    v_A = v + jnp.cross(omega, geom.rho)
+    v_s = (v_A - base_velocity(t, frame, p)) / p.a_hat
+    v_r = v_s + geom.r_dot / p.a_hat
+    ck = ContactKinematics(
+        vsx=jnp.dot(v_s, e_x),
+        vsy=jnp.dot(v_s, e_y),
+        omega_s=jnp.dot(omega, n),
+        vrx=jnp.dot(v_r, e_x),
+        vry=jnp.dot(v_r, e_y),
+    )
+    return Kinematics(v, omega, n, geom, frame, e_x, e_y, v_A, ck)
+
+
+def contact_loads(kin: Kinematics, p: CeltParams, law: AbstractContactLaw) -> ContactLoads:
+    """Loads per unit N from the chosen contact law (MODEL.md section 7)."""
+    return law.loads(kin.contact, kin.e_x, kin.e_y, kin.n, p)
+
+
+def _solve_B(p: CeltParams, x: Vec3) -> Vec3:
+    return jnp.linalg.solve(p.B, x)
+
+
+def normal_force_parts(kin: Kinematics, loads: ContactLoads, p: CeltParams) -> tuple[Scalar, Scalar]:
+    """Numerator and denominator of N (index reduction of eqs. 1-2; MODEL.md section 8).
+
+    N = [g + (w x rho).(w x n) - (w x r_dot).n + (rho x n).B^-1(w x B w) - kappa c]
+        / [1/m + (rho x n).B^-1(rho x (n + t) + m_s + m_r)],    c = v_A . n.
+    Numerator in m/s^2, denominator in 1/kg. The denominator must stay > 0.
+    """
+    w, n, rho = kin.omega, kin.n, kin.geom.rho
+    rxn = jnp.cross(rho, n)
+    Bw = p.B @ w
+    c = jnp.dot(kin.v_A, n)
+    num = (
+        p.g
+        + jnp.dot(jnp.cross(w, rho), jnp.cross(w, n))
+        - jnp.dot(jnp.cross(w, kin.geom.r_dot), n)
+        + jnp.dot(rxn, _solve_B(p, jnp.cross(w, Bw)))
+        - p.kappa * c
+    )
+    lever = jnp.cross(rho, n + loads.t) + loads.m_s + loads.m_r
+    den = 1.0 / p.m + jnp.dot(rxn, _solve_B(p, lever))
+    return num, den
+
+
+def normal_force(t: ScalarLike, y: State, params: CeltParams, contact_law: AbstractContactLaw | str | None = None) -> Scalar:
+    """Normal reaction N [N] at state y and time t (MODEL.md section 8)."""
+    law = get_contact_law(contact_law)
+    kin = kinematics(t, y, params)
+    num, den = normal_force_parts(kin, contact_loads(kin, params, law), params)
+    return num / den
+
+
+def vector_field(t: ScalarLike, y: State, params: CeltParams, contact_law: AbstractContactLaw | str | None = None) -> State:
+    """dy/dt of the wobblestone (eqs. 1, 5, 6 with N from the constraint), shape (13,).
+
+    m (v_dot + w x v) = -m g n + N (n + t)
+    B w_dot + w x (B w) = rho x N (n + t) + N (m_s + m_r)
+    n_dot = -w x n;  r_C_dot = R v (global);  psi_dot = (w1 n1 + w3 n3)/(1 - n2^2)
+    """
+    p = params
+    law = get_contact_law(contact_law)
+    kin = kinematics(t, y, p)
+    loads = contact_loads(kin, p, law)
+    num, den = normal_force_parts(kin, loads, p)
+    N = num / den
+    v, w, n = kin.v, kin.omega, kin.n
+    F = N * (n + loads.t)
+    v_dot = -jnp.cross(w, v) - p.g * n + F / p.m
+    torque = jnp.cross(kin.geom.rho, F) + N * (loads.m_s + loads.m_r)
+    w_dot = _solve_B(p, torque - jnp.cross(w, p.B @ w))
+    rC_dot = kin.frame.to_global(v, n)
+    psi_dot = (w[0] * n[0] + w[2] * n[2]) / (1.0 - n[1] ** 2)
+    return jnp.concatenate([v_dot, w_dot, kin.geom.n_dot, rC_dot, psi_dot[None]])

@@ -1,0 +1,1 @@
+"""Figures. Physics never imports this package; it imports matplotlib lazily per module."""

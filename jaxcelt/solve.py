@@ -1,0 +1,365 @@
+"""`simulate`: the one integration entry point (diffrax underneath).
+
+Jit-compiled once per (shapes, solver, contact law, static options); new parameter values,
+initial states, t0/t1 and save times do not recompile. Vmappable over parameters and
+initial states; reverse-mode differentiable through diffrax's checkpointed adjoint.
+
+Validity of the model is monitored at the end of every accepted step by wrapping the solver
+(`MonitoredSolver`): lift-off (N <= 0), the contact leaving the lower half-surface (n3 <= 0)
+and a non-positive constraint denominator are recorded on the solution with the time and the
+state where they were first seen; ``stop_on_invalid=True`` ends the solve there. The same
+wrapper records min N and max tilt, which sweeps report per lane.
+"""
+
+from __future__ import annotations
+
+from typing import Any, NamedTuple
+
+import diffrax
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optimistix as optx
+from diffrax._root_finder import use_stepsize_tol  # not re-exported at top level
+
+from . import _config  # noqa: F401
+from ._types import Array, ArrayLike, Scalar
+from .contact import AbstractContactLaw, get_contact_law
+from .model import contact_loads, kinematics, normal_force_parts, vector_field
+from .params import CeltParams
+from .state import check_state
+
+__all__ = ["simulate", "Solution", "MonitoredSolver", "Validity", "INVALID_KINDS", "STATUS", "DEFAULT_SOLVER"]
+
+INVALID_KINDS = {0: "valid", 1: "lift-off (N <= 0)", 2: "contact off the lower half-surface (n3 <= 0)", 3: "constraint denominator <= 0"}
+STATUS = {0: "success", 1: "max_steps reached", 2: "stopped at invalid state", 3: "solver failure"}
+
+
+class Validity(NamedTuple):
+    """Monitor carried through the solve (updated only on accepted steps)."""
+
+    first_invalid_t: Scalar
+    """time at the end of the first accepted step whose end state is invalid (inf if none) [s]"""
+    first_invalid_kind: Array
+    """int code, `INVALID_KINDS`"""
+    first_invalid_y: Array
+    """state where first seen (NaN if none), (13,)"""
+    min_N: Scalar
+    """minimum normal force over accepted step ends [N]"""
+    max_tilt: Scalar
+    """maximum arccos(n3) over accepted step ends [rad]"""
+
+
+def _invalid_kind(t, y, params, law) -> tuple[Array, Scalar]:
+    kin = kinematics(t, y, params)
+    num, den = normal_force_parts(kin, contact_loads(kin, params, law), params)
+    N = num / den
+    kind = jnp.where(den <= 0, 3, jnp.where(y[8] <= 0, 2, jnp.where(N <= 0, 1, 0)))
+    return kind, N
+
+
+class MonitoredSolver(diffrax.AbstractWrappedSolver):
+    """Wraps a diffrax solver; after every step evaluates validity at the step's end state.
+
+    diffrax keeps the previous solver state when a step is rejected, so the monitor sees
+    accepted steps only.
+    """
+
+    solver: diffrax.AbstractSolver
+    law: AbstractContactLaw
+
+    @property
+    def term_structure(self):
+        return self.solver.term_structure
+
+    @property
+    def interpolation_cls(self):  # pyright: ignore
+        return self.solver.interpolation_cls
+
+    @property
+    def term_compatible_contr_kwargs(self):
+        return self.solver.term_compatible_contr_kwargs
+
+    @property
+    def root_finder(self):
+        return self.solver.root_finder  # pyright: ignore
+
+    def order(self, terms):
+        return self.solver.order(terms)
+
+    def strong_order(self, terms):
+        return self.solver.strong_order(terms)
+
+    def error_order(self, terms):
+        return self.solver.error_order(terms)
+
+    def init(self, terms, t0, t1, y0, args):
+        kind, N = _invalid_kind(t0, y0, args, self.law)
+        tilt0 = jnp.arccos(jnp.clip(y0[8], -1, 1))
+        mon = Validity(
+            first_invalid_t=jnp.where(kind > 0, t0, jnp.inf).astype(y0.dtype),
+            first_invalid_kind=kind,
+            first_invalid_y=jnp.where(kind > 0, y0, jnp.nan),
+            min_N=N,
+            max_tilt=tilt0,
+        )
+        return self.solver.init(terms, t0, t1, y0, args), mon
+
+    def step(self, terms, t0, t1, y0, args, solver_state, made_jump):
+        inner, mon = solver_state
+        y1, y_err, dense, inner, result = self.solver.step(terms, t0, t1, y0, args, inner, made_jump)
+        kind, N = _invalid_kind(t1, y1, args, self.law)
+        new = (kind > 0) & (mon.first_invalid_kind == 0)
+        mon = Validity(
+            first_invalid_t=jnp.where(new, t1, mon.first_invalid_t),
+            first_invalid_kind=jnp.where(new, kind, mon.first_invalid_kind),
+            first_invalid_y=jnp.where(new, y1, mon.first_invalid_y),
+            min_N=jnp.minimum(mon.min_N, N),
+            max_tilt=jnp.maximum(mon.max_tilt, jnp.arccos(jnp.clip(y1[8], -1, 1))),
+        )
+        return y1, y_err, dense, (inner, mon), result
+
+    def func(self, terms, t0, y0, args):
+        return self.solver.func(terms, t0, y0, args)
+
+
+class Solution(eqx.Module):
+    """Result of `simulate`. Arrays gain leading batch axes under ``jax.vmap``.
+
+    ``ys[i]`` is the state at ``ts[i]``; entries after an early stop are ``inf`` (diffrax's
+    convention). ``status``: 0 success, 1 max_steps reached, 2 stopped at an invalid state
+    (``stop_on_invalid=True``), 3 other solver failure (see `STATUS`). ``success`` is
+    ``status == 0``; ``valid`` is False as soon as the model left its validity (even if the
+    solve went on).
+    """
+
+    ts: Array
+    ys: Array
+    status: Array
+    num_steps: Array
+    num_accepted_steps: Array
+    num_rejected_steps: Array
+    validity: Validity
+
+    @property
+    def success(self) -> Array:
+        return self.status == 0
+
+    @property
+    def valid(self) -> Array:
+        return self.validity.first_invalid_kind == 0
+
+    def summary(self) -> str:
+        """Human-readable one-trajectory summary (status, steps, validity)."""
+        s = int(np.asarray(self.status).reshape(-1)[0])
+        kind = int(np.asarray(self.validity.first_invalid_kind).reshape(-1)[0])
+        out = f"status: {STATUS[s]}; steps: {int(np.asarray(self.num_accepted_steps).reshape(-1)[0])} accepted, {int(np.asarray(self.num_rejected_steps).reshape(-1)[0])} rejected"
+        out += f"; min N = {float(np.asarray(self.validity.min_N).reshape(-1)[0]):.4g} N, max tilt = {np.degrees(float(np.asarray(self.validity.max_tilt).reshape(-1)[0])):.2f} deg"
+        if kind:
+            out += f"; INVALID: {INVALID_KINDS[kind]} first seen at t = {float(np.asarray(self.validity.first_invalid_t).reshape(-1)[0]):.6g} s"
+        return out
+
+
+DEFAULT_SOLVER = diffrax.Tsit5()
+
+
+class _Field(eqx.Module):
+    law: AbstractContactLaw
+
+    def __call__(self, t, y, args):
+        return vector_field(t, y, args, self.law)
+
+
+def _fill_implicit_tols(solver, rtol, atol):
+    # diffeqsolve would copy the controller's tolerances into an implicit solver's root finder;
+    # it cannot reach through our wrapper, so do it before wrapping.
+    if isinstance(solver, diffrax.AbstractImplicitSolver):
+        rf = solver.root_finder
+        for attr, val in (("rtol", rtol), ("atol", atol), ("norm", optx.rms_norm)):
+            if getattr(rf, attr, None) is use_stepsize_tol:
+                rf = eqx.tree_at(lambda r: getattr(r, attr), rf, val)
+        solver = eqx.tree_at(lambda s: s.root_finder, solver, rf)
+    return solver
+
+
+@eqx.filter_jit
+def _solve(
+    params: CeltParams,
+    y0: Array,
+    t0: Array,
+    t1: Array,
+    ts: Array | None,
+    dt0: Array | None,
+    rtol: Array,
+    atol: Array,
+    *,
+    solver: diffrax.AbstractSolver,
+    law: AbstractContactLaw,
+    max_steps: int,
+    stop_on_invalid: bool,
+    exact_ts: bool,
+    fixed_step: bool,
+    adjoint: diffrax.AbstractAdjoint,
+    progress: bool,
+) -> Solution:
+    if fixed_step:
+        controller = diffrax.ConstantStepSize()
+    else:
+        controller = diffrax.PIDController(rtol=rtol, atol=atol)
+        if exact_ts and ts is not None:
+            controller = diffrax.ClipStepSizeController(controller, step_ts=ts)
+    mon_solver = MonitoredSolver(solver=solver, law=law)
+    if ts is not None:
+        saveat = diffrax.SaveAt(ts=ts, solver_state=True)
+    else:
+        saveat = diffrax.SaveAt(t0=True, t1=True, solver_state=True)
+    event = None
+    if stop_on_invalid:
+        event = diffrax.Event(lambda t, y, args, **kw: _invalid_kind(t, y, args, law)[0] > 0)
+    sol = diffrax.diffeqsolve(
+        diffrax.ODETerm(_Field(law)),
+        mon_solver,
+        t0,
+        t1,
+        dt0,
+        y0,
+        params,
+        saveat=saveat,
+        stepsize_controller=controller,
+        max_steps=max_steps,
+        adjoint=adjoint,
+        event=event,
+        throw=False,
+        progress_meter=diffrax.TqdmProgressMeter() if progress else diffrax.NoProgressMeter(),
+    )
+    R = diffrax.RESULTS
+    status = jnp.where(
+        sol.result == R.successful,
+        0,
+        jnp.where(sol.result == R.max_steps_reached, 1, jnp.where(sol.result == R.event_occurred, 2, 3)),
+    )
+    _, mon = sol.solver_state
+    return Solution(
+        ts=sol.ts,
+        ys=sol.ys,
+        status=status,
+        num_steps=sol.stats["num_steps"],
+        num_accepted_steps=sol.stats["num_accepted_steps"],
+        num_rejected_steps=sol.stats["num_rejected_steps"],
+        validity=mon,
+    )
+
+
+def _as_float(x, dtype, name):
+    if x is None:
+        return None
+    a = jnp.asarray(x, dtype=dtype)
+    if not isinstance(a, jax.core.Tracer) and not np.all(np.isfinite(np.asarray(a))):
+        raise ValueError(f"{name!r} must be finite, got {np.asarray(a)}")
+    return a
+
+
+def simulate(
+    params: CeltParams,
+    y0: ArrayLike,
+    t1: ArrayLike,
+    *,
+    ts: ArrayLike | None = None,
+    t0: ArrayLike = 0.0,
+    solver: diffrax.AbstractSolver | None = None,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    dt0: float | None = None,
+    max_steps: int = 1_000_000,
+    contact_law: AbstractContactLaw | str | None = None,
+    stop_on_invalid: bool = False,
+    exact_ts: bool = False,
+    adjoint: diffrax.AbstractAdjoint | None = None,
+    dtype: Any = None,
+    progress: bool = False,
+) -> Solution:
+    """Integrate the wobblestone from state ``y0`` at ``t0`` to ``t1``.
+
+    Args:
+        params: `CeltParams` (may be batched under ``jax.vmap``).
+        y0: initial state (13,) on the contact manifold (see `jaxcelt.initial_state`).
+        t1: final time [s].
+        ts: save times (increasing, within [t0, t1]); default: t0 and t1.
+        t0: initial time [s] (the base phase is omega_pi t).
+        solver: any diffrax ODE solver; default `diffrax.Tsit5`. Implicit solvers work
+            (e.g. ``diffrax.Kvaerno5()``) and pay off when the friction smoothing eps is tiny.
+        rtol, atol: tolerances of the PID step-size controller. Ignored with ``dt0`` and a
+            solver without error estimate; ``dt0`` with an adaptive solver is only the first step.
+        dt0: initial (or, for non-adaptive solvers, fixed) step [s].
+        max_steps: step budget; hitting it gives ``status == 1`` rather than an exception.
+        contact_law: a law object or name (`jaxcelt.contact.CONTACT_LAWS`); default the
+            paper's generalised Pade law (eq. 13).
+        stop_on_invalid: end the solve at the first accepted step whose end state is invalid
+            (lift-off or n3 <= 0). Otherwise the solve continues and the solution says where
+            validity was first lost (``sol.validity``, ``sol.valid``).
+        exact_ts: make the step-size controller step exactly onto ``ts`` (stroboscopic
+            samples that are solver states, not interpolants).
+        adjoint: diffrax adjoint; default `diffrax.RecursiveCheckpointAdjoint` (reverse mode).
+        dtype: ``jnp.float64`` (default) or ``jnp.float32``.
+        progress: show a tqdm progress bar (single trajectories; not under vmap).
+
+    Returns:
+        `Solution` with ``ts``, ``ys`` (len(ts), 13), ``status``/``success``, step counts and
+        the validity monitor.
+    """
+    dtype = jnp.dtype(dtype or jnp.float64)
+    if dtype not in (jnp.dtype(jnp.float64), jnp.dtype(jnp.float32)):
+        raise ValueError(f"dtype must be float64 or float32, got {dtype}")
+    if not isinstance(params, CeltParams):
+        raise TypeError(f"params must be a CeltParams, got {type(params).__name__}")
+    if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1:
+        raise ValueError(f"max_steps must be a positive int, got {max_steps!r}")
+    for name, tol in (("rtol", rtol), ("atol", atol)):
+        if not isinstance(tol, jax.core.Tracer) and not (np.isfinite(tol) and tol > 0):
+            raise ValueError(f"{name!r} must be a positive finite number, got {tol!r}")
+    law = get_contact_law(contact_law)
+    check_state(y0, params, name="y0")
+    y0a = _as_float(y0, dtype, "y0")
+    if y0a.shape != (13,):
+        raise ValueError(f"'y0' must have shape (13,), got {y0a.shape} (vmap simulate for batches)")
+    t0a = _as_float(t0, dtype, "t0")
+    t1a = _as_float(t1, dtype, "t1")
+    if not isinstance(t1a, jax.core.Tracer) and not isinstance(t0a, jax.core.Tracer) and not float(t1a) > float(t0a):
+        raise ValueError(f"'t1' must be greater than 't0' (got t0={float(t0a)}, t1={float(t1a)})")
+    tsa = _as_float(ts, dtype, "ts")
+    if tsa is not None:
+        if tsa.ndim != 1 or tsa.shape[0] == 0:
+            raise ValueError(f"'ts' must be a non-empty 1-D array, got shape {tsa.shape}")
+        if not isinstance(tsa, jax.core.Tracer) and not isinstance(t1a, jax.core.Tracer):
+            a = np.asarray(tsa)
+            if np.any(np.diff(a) < 0) or a[0] < float(t0a) or a[-1] > float(t1a):
+                raise ValueError("'ts' must be non-decreasing and lie within [t0, t1]")
+    if solver is None:
+        solver = DEFAULT_SOLVER
+    fixed_step = not isinstance(solver, diffrax.AbstractAdaptiveSolver)
+    if fixed_step and dt0 is None:
+        raise ValueError(f"solver {type(solver).__name__} has no error estimate: pass a fixed step 'dt0'")
+    if dt0 is not None and not isinstance(dt0, jax.core.Tracer) and not (np.isfinite(dt0) and dt0 > 0):
+        raise ValueError(f"'dt0' must be a positive finite step, got {dt0!r}")
+    solver = _fill_implicit_tols(solver, rtol, atol)
+    if dtype == jnp.dtype(jnp.float32):
+        params = jax.tree_util.tree_map(lambda x: jnp.asarray(x, jnp.float32), params)
+    return _solve(
+        params,
+        y0a,
+        t0a,
+        t1a,
+        tsa,
+        None if dt0 is None else jnp.asarray(dt0, dtype),
+        jnp.asarray(rtol, dtype),
+        jnp.asarray(atol, dtype),
+        solver=solver,
+        law=law,
+        max_steps=max_steps,
+        stop_on_invalid=stop_on_invalid,
+        exact_ts=exact_ts,
+        fixed_step=fixed_step,
+        adjoint=adjoint or diffrax.RecursiveCheckpointAdjoint(),
+        progress=progress,
+    )
