@@ -22,7 +22,7 @@ from typing import NamedTuple
 import equinox as eqx
 import jax.numpy as jnp
 
-from ._types import Array, Scalar
+from ._types import Array, Scalar, ScalarLike
 from .elliptic import contact_integrals
 from .params import CeltParams
 
@@ -31,6 +31,11 @@ __all__ = [
     "ContactKinematics",
     "ContactLoads",
     "GeneralisedPade",
+    "Pade",
+    "CoulombSpin",
+    "Coulomb",
+    "pade_friction",
+    "law_name",
     "CONTACT_LAWS",
     "get_contact_law",
     "safe_abs_pow",
@@ -85,7 +90,9 @@ class AbstractContactLaw(eqx.Module):
     rolling_resistance: eqx.AbstractVar[bool]
 
     @abc.abstractmethod
-    def friction(self, kin: ContactKinematics, d_c: Scalar, d_s: Scalar, p: CeltParams) -> tuple[Scalar, Scalar, Scalar]:
+    def friction(
+        self, kin: ContactKinematics, d_c: Scalar, d_s: Scalar, p: CeltParams
+    ) -> tuple[Scalar, Scalar, Scalar]:
         """Non-dimensional (T_sx, T_sy, M_s) of eq. (8) or its approximant."""
 
     def rolling_distortion(self, kin: ContactKinematics, p: CeltParams) -> tuple[Scalar, Scalar]:
@@ -132,35 +139,97 @@ class GeneralisedPade(AbstractContactLaw):
     rolling_resistance: bool = eqx.field(default=True, static=True)
 
     def friction(self, kin, d_c, d_s, p):
-        vsx, vsy, w = kin.vsx, kin.vsy, kin.omega_s
-        _, E, G, H = contact_integrals(p.b)
-        V2 = vsx**2 + vsy**2 + p.eps
-        b, pi = p.b, jnp.pi
-        m_T, m_M = p.m_Ts, p.m_Ms
-        D_T = (V2 ** (1.5 * m_T) + p.b_Ts**m_T * safe_abs_pow(w, 3 * m_T)) ** (1 / m_T)
-        D_M = (p.b_Ms**m_M * safe_abs_pow(w, 3 * m_M) + V2 ** (1.5 * m_M)) ** (1 / m_M)
-        # Printed grouping: b_Ts multiplies the pi S3 terms that sit inside its bracket.
-        # The derivative-exact grouping takes them out; blend by the 0/1 switch so that the
-        # reading stays a float leaf (vmappable over readings).
-        de = p.derivative_exact
-        fac = p.b_Ts * (1 - de) + de
-        num_x = V2 * vsx + w * (
-            p.b_Ts * (4 * G * p.S0 * vsx * w - 4 * G * p.S2 * b * d_s * w**2)
-            - fac * pi * p.S3 * b * d_s * vsy**2
-            - pi * p.S3 * d_c * vsx * vsy
-        )
-        num_y = V2 * vsy + w * (
-            p.b_Ts * (4 * H * p.S0 * vsy * w + 4 * H * p.S2 * d_c * w**2)
-            + fac * pi * p.S3 * d_c * vsx**2
-            + pi * b * p.S3 * d_s * vsx * vsy
-        )
-        num_m = 4 * p.b_Ms * E * p.S2 * w**3 + pi * p.S3 * ((vsx**2 + b**2 * vsy**2) * w + V2 * (d_c * vsy - b * d_s * vsx))
-        return num_x / D_T, num_y / D_T, num_m / D_M
+        return pade_friction(kin, d_c, d_s, p, p.m_Ts, p.m_Ms)
+
+
+def pade_friction(
+    kin: ContactKinematics, d_c: Scalar, d_s: Scalar, p: CeltParams, m_T: ScalarLike, m_M: ScalarLike
+) -> tuple[Scalar, Scalar, Scalar]:
+    """Eq. (13) with exponents (m_T, m_M) given explicitly (the shared kernel of the Pade laws).
+
+    Non-dimensional (T_sx, T_sy, M_s); inputs in 1/s (MODEL.md section 7).
+    """
+    vsx, vsy, w = kin.vsx, kin.vsy, kin.omega_s
+    _, E, G, H = contact_integrals(p.b)
+    V2 = vsx**2 + vsy**2 + p.eps
+    b, pi = p.b, jnp.pi
+    D_T = (V2 ** (1.5 * m_T) + p.b_Ts**m_T * safe_abs_pow(w, 3 * m_T)) ** (1 / m_T)
+    D_M = (p.b_Ms**m_M * safe_abs_pow(w, 3 * m_M) + V2 ** (1.5 * m_M)) ** (1 / m_M)
+    # Printed grouping: b_Ts multiplies the pi S3 terms that sit inside its bracket.
+    # The derivative-exact grouping takes them out; blend by the 0/1 switch so that the
+    # reading stays a float leaf (vmappable over readings).
+    de = p.derivative_exact
+    fac = p.b_Ts * (1 - de) + de
+    num_x = V2 * vsx + w * (
+        p.b_Ts * (4 * G * p.S0 * vsx * w - 4 * G * p.S2 * b * d_s * w**2)
+        - fac * pi * p.S3 * b * d_s * vsy**2
+        - pi * p.S3 * d_c * vsx * vsy
+    )
+    num_y = V2 * vsy + w * (
+        p.b_Ts * (4 * H * p.S0 * vsy * w + 4 * H * p.S2 * d_c * w**2)
+        + fac * pi * p.S3 * d_c * vsx**2
+        + pi * b * p.S3 * d_s * vsx * vsy
+    )
+    num_m = 4 * p.b_Ms * E * p.S2 * w**3 + pi * p.S3 * ((vsx**2 + b**2 * vsy**2) * w + V2 * (d_c * vsy - b * d_s * vsx))
+    return num_x / D_T, num_y / D_T, num_m / D_M
+
+
+class Pade(AbstractContactLaw):
+    """The Pade approximant of the earlier papers: eq. (13) with m_Ts = m_Ms = 1.
+
+    D_T = V^3 + b_Ts |w|^3, D_M = b_Ms |w|^3 + V^3; numerators as in `GeneralisedPade`
+    (including the ``derivative_exact`` reading switch). ``p.m_Ts, p.m_Ms`` are ignored.
+    Satisfies the same exact value and slope limits as eq. (13) (MODEL.md section 7).
+    """
+
+    rolling_resistance: bool = eqx.field(default=True, static=True)
+
+    def friction(self, kin, d_c, d_s, p):
+        return pade_friction(kin, d_c, d_s, p, 1.0, 1.0)
+
+
+class CoulombSpin(AbstractContactLaw):
+    """Coulomb force and an uncoupled spin torque (no Contensou coupling).
+
+    T = v_s / V with V = sqrt(v_sx^2 + v_sy^2 + eps) (eq. 15 smoothing), and
+    M_s = 4 E S2 w / sqrt(w^2 + eps), the pure-spin value of the integral law (MODEL.md
+    section 7) smoothed the same way. Force and torque do not influence each other, so a
+    spinning stone slides as easily as a non-spinning one (the exact law says it slides more
+    easily). Exact limits: pure sliding and pure spin; slopes at v_s = 0 are wrong (1/sqrt(eps)).
+    With rolling resistance on, only the torque m_r (eq. 11) is added; d_c, d_s do not enter
+    the friction.
+    """
+
+    rolling_resistance: bool = eqx.field(default=True, static=True)
+
+    def friction(self, kin, d_c, d_s, p):
+        _, E, _, _ = contact_integrals(p.b)
+        V = jnp.sqrt(kin.vsx**2 + kin.vsy**2 + p.eps)
+        M = 4 * E * p.S2 * kin.omega_s / jnp.sqrt(kin.omega_s**2 + p.eps)
+        return kin.vsx / V, kin.vsy / V, M
+
+
+class Coulomb(AbstractContactLaw):
+    """Coulomb point contact: T = v_s / sqrt(|v_s|^2 + eps), no spin torque (M_s = 0).
+
+    Exact only in the pure-sliding limit. Rolling resistance (eq. 11) optional as for all laws.
+    """
+
+    rolling_resistance: bool = eqx.field(default=True, static=True)
+
+    def friction(self, kin, d_c, d_s, p):
+        V = jnp.sqrt(kin.vsx**2 + kin.vsy**2 + p.eps)
+        return kin.vsx / V, kin.vsy / V, jnp.zeros_like(kin.omega_s)
 
 
 CONTACT_LAWS: dict[str, type[AbstractContactLaw]] = {
     "generalised_pade": GeneralisedPade,
+    "pade": Pade,
+    "coulomb_spin": CoulombSpin,
+    "coulomb": Coulomb,
 }
+"""Name -> law class. ``"integral"`` (`jaxcelt.integral_law.IntegralLaw`) is added when
+`jaxcelt.integral_law` is imported (always, via ``import jaxcelt``)."""
 
 
 def get_contact_law(law: str | AbstractContactLaw | None = None) -> AbstractContactLaw:
@@ -170,8 +239,18 @@ def get_contact_law(law: str | AbstractContactLaw | None = None) -> AbstractCont
     if isinstance(law, AbstractContactLaw):
         return law
     if isinstance(law, str):
+        # "name" or "name:norr" (rolling resistance off).
         name = law.lower().replace("-", "_")
-        if name not in CONTACT_LAWS:
-            raise ValueError(f"unknown contact law {law!r}; known: {sorted(CONTACT_LAWS)}")
-        return CONTACT_LAWS[name]()
+        name, _, opt = name.partition(":")
+        if name not in CONTACT_LAWS or opt not in ("", "rr", "norr"):
+            raise ValueError(f"unknown contact law {law!r}; known: {sorted(CONTACT_LAWS)} (optionally ':norr')")
+        return CONTACT_LAWS[name](rolling_resistance=opt != "norr")
     raise TypeError(f"contact_law must be a name or an AbstractContactLaw, got {type(law).__name__}")
+
+
+def law_name(law: AbstractContactLaw) -> str:
+    """Short name of a law object, ``"name"`` or ``"name:norr"`` (inverse of `get_contact_law`)."""
+    for name, cls in CONTACT_LAWS.items():
+        if type(law) is cls:
+            return name if law.rolling_resistance else f"{name}:norr"
+    return type(law).__name__
