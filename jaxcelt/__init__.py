@@ -6,9 +6,10 @@ Importing jaxcelt enables float64 in JAX (``jax_enable_x64``).
 """
 
 from . import _config  # noqa: F401  (float64 on)
-from .contact import CONTACT_LAWS, AbstractContactLaw, GeneralisedPade, get_contact_law
+from .contact import CONTACT_LAWS, AbstractContactLaw, Coulomb, CoulombSpin, GeneralisedPade, Pade, get_contact_law
 from .diagnostics import Diagnostics, centre_position, diagnostics, energy, tilt
 from .elliptic import contact_integrals, ellipke
+from .integral_law import CustomProfile, HertzProfile, IntegralLaw, UniformProfile, patch_integrals, profile_moments
 from .model import STATE_NAMES, kinematics, normal_force, vector_field
 from .params import PARAM_NAMES, CeltParams
 from .solve import INVALID_KINDS, STATUS, Solution, simulate
@@ -22,6 +23,15 @@ __all__ = [
     "CeltParams",
     "Diagnostics",
     "GeneralisedPade",
+    "Pade",
+    "Coulomb",
+    "CoulombSpin",
+    "IntegralLaw",
+    "HertzProfile",
+    "UniformProfile",
+    "CustomProfile",
+    "patch_integrals",
+    "profile_moments",
     "INVALID_KINDS",
     "PARAM_NAMES",
     "STATE_NAMES",
