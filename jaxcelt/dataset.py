@@ -1,0 +1,225 @@
+"""Self-describing sweep datasets (xarray, netCDF via h5netcdf), written chunk by chunk, resumable.
+
+Layout of an output directory ``out/``::
+
+    out/manifest.json          what is being computed (fingerprint of params, values, y0,
+                               solver settings, chunking) -- a resume must match it
+    out/chunks/chunk_00000.nc  one netCDF file per finished chunk (atomic: temp file + rename)
+    out/sweep.nc               the merged dataset, written when every chunk is done
+
+An interrupted sweep (killed process, power cut) is resumed by calling the same
+`jaxcelt.sweep`/`bifurcation` with the same ``out``: finished chunks are read back, the
+missing ones computed. Every chunk is a deterministic function of its lanes, and float64
+round-trips netCDF exactly, so the final dataset is identical to an uninterrupted run's.
+
+The merged dataset has dimensions ``(<param>, [start,] sample, state)`` and variables
+``section`` (states at the stroboscopic times), ``t_section``, ``status``, ``valid``,
+``first_invalid_t``, ``first_invalid_kind``, ``min_N``, ``max_tilt``, ``drift``,
+``max_excursion``, ``num_steps``, ``lyapunov``, ``r_O``, ``y_final`` and the regime labels
+(`jaxcelt.regimes`). Its attributes hold the parameters, the reading switches, the solver,
+its tolerances, the sweep settings and the package/JAX versions (as JSON strings where
+nested). Load it with `open_sweep` (or plain ``xarray.open_dataset``).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from .model import STATE_NAMES
+from .params import CeltParams
+from .regimes import GLOBAL_MOTION, REGIMES, classify
+
+__all__ = ["SweepWriter", "to_dataset", "open_sweep", "SWEEP_FILE"]
+
+SWEEP_FILE = "sweep.nc"
+_ENGINE = "h5netcdf"
+
+_LANE_DIMS: dict[str, tuple[str, ...]] = {
+    "t_samples": ("sample",),
+    "samples": ("sample", "state"),
+    "y_final": ("state",),
+    "r_O": ("sample", "xyz"),
+}
+_RENAME = {"samples": "section", "t_samples": "t_section"}
+_DOCS = {
+    "section": ("state at the stroboscopic times t0 + (transient + k) 2 pi/omega_pi", "SI (see state)"),
+    "t_section": ("stroboscopic sample times", "s"),
+    "status": ("solver status: 0 success, 1 max_steps, 2 stopped invalid, 3 failure", ""),
+    "valid": ("model stayed valid (N > 0, n3 > 0) on all accepted steps", ""),
+    "first_invalid_t": ("time where validity was first lost (inf if never)", "s"),
+    "first_invalid_kind": ("0 valid, 1 lift-off, 2 n3 <= 0, 3 constraint denominator <= 0", ""),
+    "min_N": ("minimum normal force over accepted steps", "N"),
+    "max_tilt": ("maximum tilt arccos(n3) over accepted steps", "rad"),
+    "drift": ("horizontal displacement of O from first to last sample", "m"),
+    "max_excursion": ("max horizontal distance of O from its first-sample position", "m"),
+    "num_steps": ("solver steps of the main solve", ""),
+    "lyapunov": ("largest Lyapunov exponent (NaN: not computed or failed)", "1/s"),
+    "r_O": ("global position of the geometric centre O at the samples", "m"),
+    "y_final": ("last section state (continuation start)", "SI"),
+    "regime": ("local regime code, see attrs['regime_codes']", ""),
+    "period": ("period k of a periodic lane in forcing periods (0: not periodic)", ""),
+    "global_motion": ("0 bounded, 1 unbounded wandering of O, -1 unknown", ""),
+}
+
+
+def _jsonable(x: Any) -> Any:
+    if isinstance(x, dict):
+        return {str(k): _jsonable(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, np.generic):
+        return x.item()
+    return x
+
+
+def _attrs(params: CeltParams, name: str, config: Any, n_starts: int) -> dict[str, Any]:
+    from .versions import versions
+
+    pd = params.as_dict()
+    cfg = config.attrs()
+    return {
+        "title": f"jaxcelt stroboscopic sweep over {name}",
+        "swept_parameter": name,
+        "n_starts": int(n_starts),
+        "params_json": json.dumps(_jsonable(pd), sort_keys=True),
+        "switch_v_pi_sign": float(pd["v_pi_sign"]),
+        "switch_derivative_exact": float(pd["derivative_exact"]),
+        "solver": cfg["solver"],
+        "rtol": cfg["rtol"],
+        "atol": cfg["atol"],
+        "max_steps": cfg["max_steps"],
+        "transient_periods": cfg["transient_periods"],
+        "sample_periods": cfg["sample_periods"],
+        "lyapunov_periods": cfg["lyapunov_periods"],
+        "config_json": json.dumps(cfg, sort_keys=True),
+        "versions_json": json.dumps(versions(), sort_keys=True),
+        "regime_codes": json.dumps(REGIMES),
+        "global_motion_codes": json.dumps(GLOBAL_MOTION),
+        "state_names": ",".join(STATE_NAMES),
+        "model": "Awrejcewicz & Kudra (2014), DNC 3(2) 123-132; equations in MODEL.md",
+    }
+
+
+def to_dataset(result: Any, params: CeltParams, config: Any, **classify_kwargs) -> xr.Dataset:
+    """An xarray Dataset from a `jaxcelt.sweep.SweepResult` (regime labels added)."""
+    name = result.name
+    vals = np.asarray(result.values)
+    multi = vals.ndim == 2
+    lead = (name, "start") if multi else (name,)
+    coords: dict[str, Any] = {name: vals[:, 0] if multi else vals, "state": list(STATE_NAMES), "xyz": ["X1", "X2", "X3"]}
+    if multi:
+        coords["start"] = np.arange(vals.shape[1])
+    coords["sample"] = np.arange(np.shape(result.samples)[-2])
+    data = {}
+    from .sweep import _LANE_FIELDS
+
+    for key in _LANE_FIELDS:
+        if key == "values":
+            continue
+        arr = np.asarray(getattr(result, key))
+        if arr.dtype == bool:
+            arr = arr.astype(np.int8)
+        out = _RENAME.get(key, key)
+        desc, units = _DOCS[out]
+        data[out] = xr.Variable(lead + _LANE_DIMS.get(key, ()), arr, attrs={"long_name": desc, "units": units})
+    labels = classify(result.samples, result.status, result.valid, result.r_O, result.lyapunov, **classify_kwargs)
+    for key, arr in labels.items():
+        desc, units = _DOCS[key]
+        data[key] = xr.Variable(lead, arr, attrs={"long_name": desc, "units": units})
+    attrs = _attrs(params, name, config, vals.shape[1] if multi else 1)
+    attrs["classify_json"] = json.dumps(classify_kwargs, sort_keys=True)
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def open_sweep(path: str | os.PathLike) -> xr.Dataset:
+    """Load a sweep dataset (a ``sweep.nc`` file or an output directory) into memory."""
+    p = Path(path)
+    if p.is_dir():
+        p = p / SWEEP_FILE
+    with xr.open_dataset(p, engine=_ENGINE) as ds:
+        return ds.load()
+
+
+class SweepWriter:
+    """Chunk-by-chunk writer with resume (used by `jaxcelt.sweep` when ``out`` is given)."""
+
+    def __init__(self, out, *, params, name, lane_values, lane_y0, n_starts, config, chunks):
+        self.dir = Path(out)
+        self.params, self.name, self.config, self.n_starts = params, name, config, n_starts
+        self.chunks = chunks
+        manifest = {
+            "name": name,
+            "params": _jsonable(params.as_dict()),
+            "lane_values": np.asarray(lane_values).tolist(),
+            "lane_y0_sha256": hashlib.sha256(np.ascontiguousarray(lane_y0, dtype=np.float64).tobytes()).hexdigest(),
+            "n_starts": int(n_starts),
+            "config": config.attrs(),
+            "chunks": [np.asarray(c).tolist() for c in chunks],
+        }
+        self.fingerprint = hashlib.sha256(json.dumps(manifest, sort_keys=True).encode()).hexdigest()
+        manifest["fingerprint"] = self.fingerprint
+        (self.dir / "chunks").mkdir(parents=True, exist_ok=True)
+        mpath = self.dir / "manifest.json"
+        if mpath.exists():
+            old = json.loads(mpath.read_text())
+            if old.get("fingerprint") != self.fingerprint:
+                raise ValueError(
+                    f"{self.dir} holds a different sweep (manifest fingerprint differs); use a new directory or delete it"
+                )
+        else:
+            _atomic_write_text(mpath, json.dumps(manifest, indent=1, sort_keys=True))
+
+    def _chunk_path(self, ci: int) -> Path:
+        return self.dir / "chunks" / f"chunk_{ci:05d}.nc"
+
+    def write_chunk(self, ci: int, res: dict[str, np.ndarray]) -> None:
+        data = {}
+        for key, arr in res.items():
+            arr = np.asarray(arr)
+            if arr.dtype == bool:
+                arr = arr.astype(np.int8)
+            data[key] = xr.Variable(("lane",) + tuple(f"{key}_{i}" for i in range(1, arr.ndim)), arr)
+        ds = xr.Dataset(data, attrs={"fingerprint": self.fingerprint, "chunk": ci})
+        path = self._chunk_path(ci)
+        tmp = path.with_suffix(".nc.tmp")
+        ds.to_netcdf(tmp, engine=_ENGINE)
+        os.replace(tmp, path)
+
+    def load_done(self) -> dict[int, dict[str, np.ndarray]]:
+        done = {}
+        for ci in range(len(self.chunks)):
+            path = self._chunk_path(ci)
+            if not path.exists():
+                continue
+            with xr.open_dataset(path, engine=_ENGINE) as ds:
+                if ds.attrs.get("fingerprint") != self.fingerprint:
+                    continue
+                res = {k: ds[k].values for k in ds.data_vars}
+            for k in ("valid",):
+                if k in res:
+                    res[k] = res[k].astype(bool)
+            done[ci] = res
+        return done
+
+    def finalize(self, result: Any) -> xr.Dataset:
+        ds = to_dataset(result, self.params, self.config)
+        path = self.dir / SWEEP_FILE
+        tmp = path.with_suffix(".nc.tmp")
+        ds.to_netcdf(tmp, engine=_ENGINE)
+        os.replace(tmp, path)
+        return ds
+
+
+def _atomic_write_text(path: Path, text: str) -> None:
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)

@@ -1,0 +1,120 @@
+"""Automatic regime labels of a stroboscopic sweep: period-k, quasi-periodic, chaotic, invalid, failed.
+
+Local motion (attitude and spin) and global motion (path of the geometric centre O on the
+base) are labelled separately, as the paper does (Figs. 4-7: "locally periodic with
+unbounded global wandering" at omega_pi = 15.6 rad/s).
+
+Local label, from the section samples x_j = (omega, n)(t_j) (state components 3:9, which
+with psi determine the dynamics; r_C does not feed back):
+
+* ``failed``   -- the solve did not finish (status != 0, e.g. max_steps);
+* ``invalid``  -- the model left its validity (lift-off, n3 <= 0) somewhere in the run;
+* ``period-k`` -- smallest k <= ``max_period`` with max_j |x_{j+k} - x_j| <= tol (1 + max|x|)
+  over the samples; k = 1 is the forcing period (a period-1 orbit of the stroboscopic map);
+* otherwise ``chaotic`` if the largest Lyapunov exponent exceeds ``chaos_threshold`` [1/s],
+  ``quasi-periodic`` if it does not, ``aperiodic`` if no exponent was computed.
+
+Global label: ``unbounded`` when O's net horizontal displacement over the samples exceeds
+``drift_threshold`` [m] and is at least half of its maximum excursion (steady wandering
+away), else ``bounded``. The thresholds are heuristics; the raw numbers (drift, excursion,
+exponent) are kept beside the labels.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["REGIMES", "GLOBAL_MOTION", "detect_period", "classify", "regime_names"]
+
+REGIMES: dict[int, str] = {0: "failed", 1: "invalid", 2: "periodic", 3: "quasi-periodic", 4: "chaotic", 5: "aperiodic"}
+"""Integer codes of the local regime (periodic carries its period k separately)."""
+GLOBAL_MOTION: dict[int, str] = {0: "bounded", 1: "unbounded", -1: "unknown"}
+
+
+def detect_period(x: np.ndarray, *, max_period: int = 16, tol: float = 1e-4) -> int:
+    """Smallest period k (in samples) of a sequence x (S, d), or 0 if none up to max_period.
+
+    Criterion: max over j and components of |x[j+k] - x[j]| <= tol * (1 + max|x|), using all
+    S - k pairs (needs S >= 2k so each point is compared at least once). Non-finite -> 0.
+    """
+    x = np.asarray(x, dtype=float)
+    if x.ndim == 1:
+        x = x[:, None]
+    if not np.all(np.isfinite(x)):
+        return 0
+    scale = tol * (1.0 + np.max(np.abs(x)))
+    S = x.shape[0]
+    for k in range(1, max_period + 1):
+        if S < 2 * k:
+            break
+        if np.max(np.abs(x[k:] - x[:-k])) <= scale:
+            return k
+    return 0
+
+
+def classify(
+    samples: np.ndarray,
+    status: np.ndarray,
+    valid: np.ndarray,
+    r_O: np.ndarray,
+    lyapunov: np.ndarray | None = None,
+    *,
+    max_period: int = 16,
+    tol: float = 1e-4,
+    chaos_threshold: float = 0.02,
+    drift_threshold: float = 0.05,
+) -> dict[str, np.ndarray]:
+    """Labels for every lane (any leading shape ``...``).
+
+    Args:
+        samples: section states (..., S, 13). status, valid: (...). r_O: (..., S, 3) [m].
+        lyapunov: (...) [1/s] or None.
+        max_period, tol: see `detect_period`.
+        chaos_threshold: exponent above which a non-periodic lane is chaotic [1/s]; the
+            finite-time estimate of a quasi-periodic orbit is O(1/t) from 0.
+        drift_threshold: net displacement of O that counts as unbounded wandering [m].
+
+    Returns:
+        dict of arrays (...): ``regime`` (`REGIMES` code), ``period`` (k, 0 if not periodic),
+        ``global_motion`` (`GLOBAL_MOTION` code).
+    """
+    samples = np.asarray(samples)
+    lead = samples.shape[:-2]
+    flat = samples.reshape(-1, *samples.shape[-2:])
+    st = np.asarray(status).reshape(-1)
+    va = np.asarray(valid).reshape(-1)
+    ro = np.asarray(r_O).reshape(-1, *np.shape(r_O)[-2:])
+    ly = None if lyapunov is None else np.asarray(lyapunov, dtype=float).reshape(-1)
+    regime = np.zeros(flat.shape[0], dtype=np.int32)
+    period = np.zeros(flat.shape[0], dtype=np.int32)
+    glob = np.full(flat.shape[0], -1, dtype=np.int32)
+    for i in range(flat.shape[0]):
+        if st[i] != 0:
+            regime[i] = 0
+            continue
+        k = detect_period(flat[i][:, 3:9], max_period=max_period, tol=tol)
+        if not va[i]:
+            regime[i] = 1
+        elif k > 0:
+            regime[i], period[i] = 2, k
+        elif ly is not None and np.isfinite(ly[i]):
+            regime[i] = 4 if ly[i] > chaos_threshold else 3
+        else:
+            regime[i] = 5
+        d = ro[i][:, :2] - ro[i][0, :2]
+        if np.all(np.isfinite(d)):
+            net = float(np.linalg.norm(d[-1]))
+            exc = float(np.max(np.linalg.norm(d, axis=-1)))
+            glob[i] = int(net > drift_threshold and net >= 0.5 * exc)
+    return dict(regime=regime.reshape(lead), period=period.reshape(lead), global_motion=glob.reshape(lead))
+
+
+def regime_names(regime: np.ndarray, period: np.ndarray) -> np.ndarray:
+    """Human-readable labels ("period-2", "chaotic", ...) for code arrays."""
+    regime = np.asarray(regime)
+    period = np.asarray(period)
+    out = np.empty(regime.shape, dtype=object)
+    for idx in np.ndindex(regime.shape):
+        r = int(regime[idx])
+        out[idx] = f"period-{int(period[idx])}" if r == 2 else REGIMES[r]
+    return out

@@ -1,0 +1,489 @@
+"""Parameter sweeps: bifurcation diagrams, continuation, multi-start, chunking and sharding.
+
+A *lane* is one (parameter value, initial condition) pair. For every lane the stone is
+integrated for ``transient_periods`` forcing periods T = 2 pi / omega_pi (eq. 17) and then
+sampled stroboscopically at t_k = t0 + (transient_periods + k) T, k = 0 .. sample_periods-1.
+The samples are solver states, not interpolants: `jaxcelt.simulate` is called with
+``exact_ts=True`` (diffrax's ``ClipStepSizeController(step_ts=ts)``), so the controller
+steps exactly onto every t_k.
+
+Execution model
+---------------
+* Lanes are processed in chunks of ``chunk_size``; a chunk is **one** jitted
+  ``jax.vmap`` of the one-lane kernel (`_lane`), so the compile happens once per chunk
+  shape and static configuration. Inside a chunk the vmapped while loop runs until its
+  slowest lane is done; finished lanes are masked, hence a lane's result does not depend on
+  its neighbours (a lane that hits ``max_steps`` is flagged and the others are bitwise
+  unchanged). Adjacent parameter values cost about the same, so chunks of neighbouring
+  values waste few step slots; ``sort_by_cost=True`` additionally orders lanes by a cost
+  proxy (number of forcing periods per unit time is the same for all lanes, so the proxy is
+  the lane's time span t1 - t0, i.e. 1/omega_pi for frequency sweeps).
+* Chunks are sharded over all local JAX devices with `jax.shard_map` on a 1-D
+  ``Mesh(jax.local_devices(), ("lanes",))``: each device runs its own vmapped solve over its
+  slice of the chunk (no cross-device synchronisation inside the time loop). The chunk is
+  padded to a multiple of the device count with copies of its last lane (discarded).
+  On CPU, ``XLA_FLAGS=--xla_force_host_platform_device_count=K`` gives K host devices.
+
+Multi-host (several machines, each with local accelerators)
+-----------------------------------------------------------
+Call ``jax.distributed.initialize(coordinator_address, num_processes, process_id)`` at the
+start of each process, then give each process its own share of the parameter values, e.g.
+``values[jax.process_index()::jax.process_count()]``, and call `bifurcation` there: it
+shards over that process's *local* devices only, so hosts never wait for each other. Write
+each process's dataset to its own directory (``out=f"run/host{jax.process_index()}"``) and
+concatenate them with `jaxcelt.dataset.open_sweep` + ``xarray.concat`` afterwards. Lanes
+are independent, so this is embarrassingly parallel and gives the same numbers as one host.
+
+Continuation
+------------
+`continuation` walks the values in order (up, down, or both) and starts each value from the
+previous value's final state (the last stroboscopic sample; base phase omega_pi t = 0 mod
+2 pi there, so the restart at t0 = 0 is phase consistent), like DynamicalSystems.jl's
+default. It is sequential over values but vmapped over several initial conditions.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import diffrax
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from . import _config  # noqa: F401
+from ._types import Array
+from .contact import AbstractContactLaw, get_contact_law
+from .diagnostics import centre_position
+from .lyapunov import celt_lyapunov
+from .params import PARAM_NAMES, CeltParams
+from .solve import DEFAULT_SOLVER, simulate
+from .state import initial_state
+
+__all__ = ["SweepConfig", "SweepResult", "bifurcation", "sweep", "continuation", "lanes_params", "parse_range"]
+
+
+@dataclasses.dataclass(frozen=True)
+class SweepConfig:
+    """Static settings of a sweep (everything but the parameter values and initial states)."""
+
+    transient_periods: int = 200
+    sample_periods: int = 100
+    lyapunov_periods: int = 0
+    """periods of tangent dynamics after the transient (0: no Lyapunov exponent)"""
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    max_steps: int = 1_000_000
+    solver: Any = DEFAULT_SOLVER
+    contact_law: Any = None
+    t0: float = 0.0
+
+    def __post_init__(self):
+        for name in ("transient_periods", "sample_periods", "lyapunov_periods", "max_steps"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < 0:
+                raise ValueError(f"{name!r} must be a non-negative int, got {v!r}")
+        if self.sample_periods < 1:
+            raise ValueError(f"'sample_periods' must be >= 1, got {self.sample_periods}")
+        if self.max_steps < 1:
+            raise ValueError(f"'max_steps' must be >= 1, got {self.max_steps}")
+        for name in ("rtol", "atol"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"{name!r} must be a positive finite number, got {v!r}")
+
+    def attrs(self) -> dict[str, Any]:
+        """Plain-python description (for dataset attributes)."""
+        law = get_contact_law(self.contact_law)
+        return dict(
+            transient_periods=int(self.transient_periods),
+            sample_periods=int(self.sample_periods),
+            lyapunov_periods=int(self.lyapunov_periods),
+            rtol=float(self.rtol),
+            atol=float(self.atol),
+            max_steps=int(self.max_steps),
+            solver=type(self.solver).__name__,
+            step_size_controller="PIDController + ClipStepSizeController(step_ts=section times)",
+            contact_law=f"{type(law).__name__}(rolling_resistance={law.rolling_resistance})",
+            t0=float(self.t0),
+        )
+
+
+class SweepResult(eqx.Module):
+    """Per-lane results of a sweep (numpy arrays; leading axis = lanes, or (values, starts)).
+
+    Attributes (L = lanes, S = sample_periods):
+        values: swept parameter value per lane, (L,)
+        t_samples: stroboscopic times [s], (L, S)
+        samples: states at the section, (L, S, 13) (inf after a failed solve)
+        y_final: last sample (L, 13) -- the start of a continuation step
+        status: `jaxcelt.STATUS` code, (L,); success = status == 0
+        valid: model stayed valid (N > 0, n3 > 0, denominator > 0) on all accepted steps, (L,)
+        first_invalid_t [s], first_invalid_kind (`jaxcelt.INVALID_KINDS`), (L,)
+        min_N [N], max_tilt [rad]: over all accepted steps (transient included), (L,)
+        drift: horizontal displacement of O from the first to the last sample [m], (L,)
+        max_excursion: max horizontal distance of O from its first-sample position [m], (L,)
+        num_steps: solver steps (main solve), (L,)
+        lyapunov: largest Lyapunov exponent [1/s] (NaN if not computed / failed), (L,)
+        r_O: global position of the geometric centre at the samples [m], (L, S, 3)
+    """
+
+    name: str = eqx.field(static=True)
+    values: np.ndarray
+    t_samples: np.ndarray
+    samples: np.ndarray
+    y_final: np.ndarray
+    status: np.ndarray
+    valid: np.ndarray
+    first_invalid_t: np.ndarray
+    first_invalid_kind: np.ndarray
+    min_N: np.ndarray
+    max_tilt: np.ndarray
+    drift: np.ndarray
+    max_excursion: np.ndarray
+    num_steps: np.ndarray
+    lyapunov: np.ndarray
+    r_O: np.ndarray
+
+    @property
+    def success(self) -> np.ndarray:
+        return self.status == 0
+
+
+_LANE_FIELDS = tuple(f.name for f in dataclasses.fields(SweepResult) if f.name != "name")
+
+
+def parse_range(spec: str) -> np.ndarray:
+    """``"10:20:400"`` -> 400 values from 10 to 20 inclusive; ``"14,15.6,17"`` -> a list."""
+    if ":" in spec:
+        parts = spec.split(":")
+        if len(parts) != 3:
+            raise ValueError(f"range {spec!r} must be START:STOP:COUNT")
+        a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
+        if n < 1:
+            raise ValueError(f"range {spec!r}: COUNT must be >= 1")
+        return np.linspace(a, b, n)
+    return np.array([float(s) for s in spec.split(",") if s.strip()])
+
+
+def lanes_params(params: CeltParams, name: str, values: Array) -> CeltParams:
+    """A batched `CeltParams` with a leading lane axis: field ``name`` = ``values``, others broadcast."""
+    if name not in PARAM_NAMES:
+        raise ValueError(f"unknown parameter {name!r}; known: {PARAM_NAMES}")
+    values = jnp.asarray(values, dtype=jnp.float64)
+    L = values.shape[0]
+    pb = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(jnp.asarray(x), (L,)), params)
+    return eqx.tree_at(lambda p: getattr(p, name), pb, values)
+
+
+def _lane(p: CeltParams, y0: Array, cfg: SweepConfig) -> dict[str, Array]:
+    """One lane: transient, exact stroboscopic samples, extras, optional Lyapunov exponent."""
+    T = 2 * jnp.pi / p.omega_pi
+    t0 = jnp.asarray(cfg.t0, jnp.float64)
+    ts = t0 + T * (cfg.transient_periods + jnp.arange(cfg.sample_periods, dtype=jnp.float64))
+    sol = simulate(
+        p,
+        y0,
+        ts[-1],
+        ts=ts,
+        t0=t0,
+        solver=cfg.solver,
+        rtol=cfg.rtol,
+        atol=cfg.atol,
+        max_steps=cfg.max_steps,
+        contact_law=cfg.contact_law,
+        exact_ts=True,
+    )
+    ys = sol.ys
+    r_O = jax.vmap(centre_position, in_axes=(0, None))(ys, p)
+    dxy = r_O[:, :2] - r_O[0, :2]
+    out = dict(
+        t_samples=ts,
+        samples=ys,
+        y_final=ys[-1],
+        status=sol.status,
+        valid=sol.valid,
+        first_invalid_t=sol.validity.first_invalid_t,
+        first_invalid_kind=sol.validity.first_invalid_kind,
+        min_N=sol.validity.min_N,
+        max_tilt=sol.validity.max_tilt,
+        drift=jnp.linalg.norm(dxy[-1]),
+        max_excursion=jnp.max(jnp.linalg.norm(dxy, axis=-1)),
+        num_steps=sol.num_steps,
+        r_O=r_O,
+    )
+    if cfg.lyapunov_periods > 0:
+        ok = sol.status == 0
+        y_start = jnp.where(ok, ys[0], y0)  # a failed lane still runs (masked) but is NaN
+        lr = celt_lyapunov(
+            p,
+            y_start,
+            periods=cfg.lyapunov_periods,
+            t0=ts[0],
+            contact_law=cfg.contact_law,
+            solver=cfg.solver,
+            rtol=cfg.rtol,
+            atol=cfg.atol,
+            max_steps=max(cfg.max_steps // max(cfg.transient_periods + cfg.sample_periods, 1), 10_000),
+        )
+        out["lyapunov"] = jnp.where(ok, lr.exponent, jnp.nan)
+    else:
+        out["lyapunov"] = jnp.full((), jnp.nan)
+    return out
+
+
+@eqx.filter_jit
+def _chunk(pb: CeltParams, y0b: Array, cfg: SweepConfig, mesh: Any) -> dict[str, Array]:
+    run = jax.vmap(lambda p, y: _lane(p, y, cfg))
+    if mesh is None:
+        return run(pb, y0b)
+    spec = jax.sharding.PartitionSpec("lanes")
+    return jax.shard_map(run, mesh=mesh, in_specs=(spec, spec), out_specs=spec, check_vma=False)(pb, y0b)
+
+
+def _mesh(devices: Sequence[Any] | None) -> Any:
+    devs = list(devices) if devices is not None else jax.local_devices()
+    if len(devs) <= 1:
+        return None
+    return jax.sharding.Mesh(np.array(devs), ("lanes",))
+
+
+def _pad(x: np.ndarray, n: int) -> np.ndarray:
+    if len(x) == n:
+        return x
+    return np.concatenate([x, np.repeat(x[-1:], n - len(x), axis=0)])
+
+
+def run_lanes(
+    pb: CeltParams,
+    y0b: Array,
+    cfg: SweepConfig,
+    *,
+    devices: Sequence[Any] | None = None,
+) -> dict[str, np.ndarray]:
+    """Run one chunk of lanes (batched params and y0 with a leading lane axis) and return numpy arrays.
+
+    Sharded over ``devices`` (default all local devices); padded to a multiple of their number.
+    """
+    mesh = _mesh(devices)
+    L = int(np.shape(y0b)[0])
+    ndev = 1 if mesh is None else mesh.devices.size
+    Lp = math.ceil(L / ndev) * ndev
+    pb_np = jax.tree_util.tree_map(lambda x: _pad(np.asarray(x), Lp), pb)
+    y0_np = _pad(np.asarray(y0b, dtype=np.float64), Lp)
+    out = _chunk(pb_np, y0_np, cfg, mesh)
+    out = jax.tree_util.tree_map(lambda x: np.asarray(x)[:L], jax.block_until_ready(out))
+    return out
+
+
+def _broadcast_y0(params: CeltParams, y0: Any, n_values: int) -> np.ndarray:
+    """y0: None (rest), (13,) or (K, 13) -> (n_values, K, 13)."""
+    if y0 is None:
+        y0 = initial_state(params)
+    y = np.asarray(y0, dtype=np.float64)
+    if y.ndim == 1:
+        y = y[None]
+    if y.ndim == 2:
+        y = np.broadcast_to(y[None], (n_values, *y.shape))
+    if y.ndim != 3 or y.shape[0] != n_values or y.shape[2] != 13:
+        raise ValueError(f"y0 must have shape (13,), (K, 13) or (n_values, K, 13); got {np.shape(y0)}")
+    return np.ascontiguousarray(y)
+
+
+def sweep(
+    params: CeltParams,
+    name: str,
+    values: Any,
+    *,
+    transient_periods: int = 200,
+    sample_periods: int = 100,
+    y0: Any = None,
+    lyapunov_periods: int = 0,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    max_steps: int = 1_000_000,
+    solver: diffrax.AbstractSolver | None = None,
+    contact_law: AbstractContactLaw | str | None = None,
+    t0: float = 0.0,
+    chunk_size: int | None = None,
+    sort_by_cost: bool = False,
+    devices: Sequence[Any] | None = None,
+    out: str | None = None,
+    progress: bool = False,
+    on_chunk: Callable[[int, dict[str, np.ndarray]], None] | None = None,
+) -> SweepResult:
+    """Sweep the scalar parameter ``name`` of `CeltParams` over ``values`` (stroboscopic sampling).
+
+    Args:
+        params: base parameters; field ``name`` is replaced by each value.
+        name: any `CeltParams` field (``"omega_pi"``, ``"q_pi"``, ``"mu"``, ...).
+        values: 1-D array of values (L_v,).
+        transient_periods, sample_periods: forcing periods T = 2 pi/omega_pi discarded,
+            then sampled (section times t0 + (transient + k) T, hit exactly).
+        y0: initial state(s): None (at rest on the base, `initial_state`), (13,), (K, 13)
+            (multi-start: every value from each of K states) or (L_v, K, 13).
+        lyapunov_periods: > 0 also integrates the tangent dynamics for that many periods
+            after the transient (`jaxcelt.lyapunov.celt_lyapunov`) -> ``lyapunov`` [1/s].
+        rtol, atol, max_steps, solver, contact_law, t0: as in `jaxcelt.simulate`.
+        chunk_size: lanes per jitted vmapped solve (default: all lanes in one chunk).
+        sort_by_cost: order lanes by the cost proxy (time span) before chunking.
+        devices: devices to shard each chunk over (default all local devices).
+        out: directory; write the dataset chunk by chunk there and resume a previous,
+            interrupted run of the same sweep (`jaxcelt.dataset`).
+        progress: tqdm bar over lanes (with ETA).
+        on_chunk: ``on_chunk(chunk_index, chunk_results)`` called after each chunk.
+
+    Returns:
+        `SweepResult` with lane arrays reshaped to (L_v, K, ...) when y0 has K starts, else (L_v, ...).
+    """
+    cfg = SweepConfig(
+        transient_periods=int(transient_periods),
+        sample_periods=int(sample_periods),
+        lyapunov_periods=int(lyapunov_periods),
+        rtol=float(rtol),
+        atol=float(atol),
+        max_steps=int(max_steps),
+        solver=solver if solver is not None else DEFAULT_SOLVER,
+        contact_law=contact_law,
+        t0=float(t0),
+    )
+    values = np.atleast_1d(np.asarray(values, dtype=np.float64))
+    if values.ndim != 1 or values.size == 0:
+        raise ValueError(f"values must be a non-empty 1-D array, got shape {values.shape}")
+    if not np.all(np.isfinite(values)):
+        raise ValueError("values must be finite")
+    params.replace(**{name: values.min()})  # validates the range ends (raises ValueError naming the field)
+    params.replace(**{name: values.max()})
+    multi = y0 is not None and np.ndim(y0) >= 2
+    y0v = _broadcast_y0(params, y0, len(values))
+    Lv, K = y0v.shape[:2]
+    lane_values = np.repeat(values, K)
+    lane_y0 = y0v.reshape(Lv * K, 13)
+    L = Lv * K
+    pb_all = lanes_params(params, name, lane_values)
+    if not np.all(np.asarray(pb_all.omega_pi) > 0):
+        raise ValueError("stroboscopic sampling needs omega_pi > 0 in every lane")
+    order = np.arange(L)
+    if sort_by_cost:
+        order = np.argsort(1.0 / np.asarray(pb_all.omega_pi), kind="stable")
+    cs = L if chunk_size is None else max(1, int(chunk_size))
+    chunks = [order[i : i + cs] for i in range(0, L, cs)]
+
+    writer = None
+    done: dict[int, dict[str, np.ndarray]] = {}
+    if out is not None:
+        from .dataset import SweepWriter
+
+        writer = SweepWriter(out, params=params, name=name, lane_values=lane_values, lane_y0=lane_y0, n_starts=K, config=cfg, chunks=chunks)
+        done = writer.load_done()
+
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=L, unit="lane", desc=f"sweep {name}", initial=sum(len(chunks[i]) for i in done))
+    results: dict[int, dict[str, np.ndarray]] = dict(done)
+    for ci, idx in enumerate(chunks):
+        if ci in results:
+            continue
+        pb = jax.tree_util.tree_map(lambda x: np.asarray(x)[idx], pb_all)
+        t_start = time.perf_counter()
+        res = run_lanes(pb, lane_y0[idx], cfg, devices=devices)
+        res["_seconds"] = np.full(len(idx), (time.perf_counter() - t_start) / len(idx))
+        results[ci] = res
+        if writer is not None:
+            writer.write_chunk(ci, res)
+        if on_chunk is not None:
+            on_chunk(ci, res)
+        if bar is not None:
+            bar.update(len(idx))
+    if bar is not None:
+        bar.close()
+
+    merged: dict[str, np.ndarray] = {}
+    for key in _LANE_FIELDS:
+        if key == "values":
+            continue
+        parts = [results[ci][key] for ci in range(len(chunks))]
+        cat = np.concatenate(parts, axis=0)
+        full = np.empty_like(cat)
+        full[np.concatenate(chunks)] = cat
+        merged[key] = full.reshape((Lv, K, *full.shape[1:])) if multi else full
+    vals = lane_values.reshape(Lv, K) if multi else lane_values
+    result = SweepResult(name=name, values=vals, **merged)
+    if writer is not None:
+        writer.finalize(result)
+    return result
+
+
+def bifurcation(
+    params: CeltParams,
+    omega_pi_values: Any,
+    *,
+    transient_periods: int = 200,
+    sample_periods: int = 100,
+    y0: Any = None,
+    **kwargs,
+) -> SweepResult:
+    """Bifurcation diagram data over the forcing frequency omega_pi [rad/s] (the paper's Fig. 3).
+
+    ``sweep(params, "omega_pi", omega_pi_values, ...)``; see `sweep` for all options. Plot
+    ``result.samples[..., 4]`` (omega_2 at the section) against ``result.values``.
+    """
+    return sweep(params, "omega_pi", omega_pi_values, transient_periods=transient_periods, sample_periods=sample_periods, y0=y0, **kwargs)
+
+
+def continuation(
+    params: CeltParams,
+    name: str,
+    values: Any,
+    *,
+    direction: str = "up",
+    transient_periods: int = 100,
+    sample_periods: int = 50,
+    y0: Any = None,
+    progress: bool = False,
+    **kwargs,
+) -> dict[str, SweepResult]:
+    """Continuation sweep: each value starts from the previous value's final state.
+
+    Args:
+        direction: ``"up"`` (increasing values), ``"down"`` or ``"both"`` (up, then down
+            starting from the up sweep's last state) -- hysteresis and coexisting
+            attractors show as differing branches.
+        y0: None, (13,) or (K, 13): K starts continued side by side (vmapped).
+        other arguments: as `sweep` (``t0`` is 0 for every step; the final state of a step
+        sits at a section time, base phase 0, so the restart is phase consistent).
+
+    Returns:
+        ``{"up": SweepResult, "down": SweepResult}`` (the requested directions), values in
+        sweep order, lane arrays shaped (L_v, K, ...).
+    """
+    if direction not in ("up", "down", "both"):
+        raise ValueError(f"direction must be 'up', 'down' or 'both', got {direction!r}")
+    values = np.sort(np.atleast_1d(np.asarray(values, dtype=np.float64)))
+    y = _broadcast_y0(params, y0, 1)[0]  # (K, 13)
+    out: dict[str, SweepResult] = {}
+    dirs = ["up", "down"] if direction == "both" else [direction]
+    for d in dirs:
+        vs = values if d == "up" else values[::-1]
+        steps = []
+        it = vs
+        if progress:
+            from tqdm.auto import tqdm
+
+            it = tqdm(vs, desc=f"continuation {d}", unit="value")
+        for v in it:
+            r = sweep(params, name, [v], transient_periods=transient_periods, sample_periods=sample_periods, y0=y[None], **kwargs)
+            steps.append(r)
+            ok = r.status[0] == 0
+            # a failed step restarts the next value from the last good state
+            y = np.where(ok[:, None], r.y_final[0], y)
+        merged = {k: np.concatenate([getattr(s, k) for s in steps], axis=0) for k in _LANE_FIELDS}
+        out[d] = SweepResult(name=name, **merged)
+    return out
