@@ -115,7 +115,11 @@ def to_dataset(result: Any, params: CeltParams, config: Any, **classify_kwargs) 
     vals = np.asarray(result.values)
     multi = vals.ndim == 2
     lead = (name, "start") if multi else (name,)
-    coords: dict[str, Any] = {name: vals[:, 0] if multi else vals, "state": list(STATE_NAMES), "xyz": ["X1", "X2", "X3"]}
+    coords: dict[str, Any] = {
+        name: vals[:, 0] if multi else vals,
+        "state": list(STATE_NAMES),
+        "xyz": ["X1", "X2", "X3"],
+    }
     if multi:
         coords["start"] = np.arange(vals.shape[1])
     coords["sample"] = np.arange(np.shape(result.samples)[-2])

@@ -65,7 +65,17 @@ from .params import PARAM_NAMES, CeltParams
 from .solve import DEFAULT_SOLVER, simulate
 from .state import initial_state
 
-__all__ = ["SweepConfig", "SweepResult", "bifurcation", "sweep", "continuation", "lanes_params", "parse_range"]
+__all__ = [
+    "SweepConfig",
+    "SweepResult",
+    "bifurcation",
+    "sweep",
+    "continuation",
+    "lanes_params",
+    "parse_range",
+    "orbit",
+    "run_lanes",
+]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -181,11 +191,15 @@ def lanes_params(params: CeltParams, name: str, values: Array) -> CeltParams:
     return eqx.tree_at(lambda p: getattr(p, name), pb, values)
 
 
-def _lane(p: CeltParams, y0: Array, cfg: SweepConfig) -> dict[str, Array]:
-    """One lane: transient, exact stroboscopic samples, extras, optional Lyapunov exponent."""
+def _lane(p: CeltParams, y0: Array, transient: Array, cfg: SweepConfig) -> dict[str, Array]:
+    """One lane: transient, exact stroboscopic samples, extras, optional Lyapunov exponent.
+
+    ``transient`` (periods, traced so that changing it does not recompile) overrides
+    ``cfg.transient_periods``.
+    """
     T = 2 * jnp.pi / p.omega_pi
     t0 = jnp.asarray(cfg.t0, jnp.float64)
-    ts = t0 + T * (cfg.transient_periods + jnp.arange(cfg.sample_periods, dtype=jnp.float64))
+    ts = t0 + T * (transient + jnp.arange(cfg.sample_periods, dtype=jnp.float64))
     sol = simulate(
         p,
         y0,
@@ -201,7 +215,7 @@ def _lane(p: CeltParams, y0: Array, cfg: SweepConfig) -> dict[str, Array]:
     )
     ys = sol.ys
     r_O = jax.vmap(centre_position, in_axes=(0, None))(ys, p)
-    dxy = r_O[:, :2] - r_O[0, :2]
+    dxy = r_O[:, :2] - r_O[0:1, :2]
     out = dict(
         t_samples=ts,
         samples=ys,
@@ -229,7 +243,7 @@ def _lane(p: CeltParams, y0: Array, cfg: SweepConfig) -> dict[str, Array]:
             solver=cfg.solver,
             rtol=cfg.rtol,
             atol=cfg.atol,
-            max_steps=max(cfg.max_steps // max(cfg.transient_periods + cfg.sample_periods, 1), 10_000),
+            max_steps=cfg.max_steps,  # per period: a bound, not a cost
         )
         out["lyapunov"] = jnp.where(ok, lr.exponent, jnp.nan)
     else:
@@ -238,8 +252,8 @@ def _lane(p: CeltParams, y0: Array, cfg: SweepConfig) -> dict[str, Array]:
 
 
 @eqx.filter_jit
-def _chunk(pb: CeltParams, y0b: Array, cfg: SweepConfig, mesh: Any) -> dict[str, Array]:
-    run = jax.vmap(lambda p, y: _lane(p, y, cfg))
+def _chunk(pb: CeltParams, y0b: Array, transient: Array, cfg: SweepConfig, mesh: Any) -> dict[str, Array]:
+    run = jax.vmap(lambda p, y: _lane(p, y, transient, cfg))
     if mesh is None:
         return run(pb, y0b)
     spec = jax.sharding.PartitionSpec("lanes")
@@ -276,7 +290,8 @@ def run_lanes(
     Lp = math.ceil(L / ndev) * ndev
     pb_np = jax.tree_util.tree_map(lambda x: _pad(np.asarray(x), Lp), pb)
     y0_np = _pad(np.asarray(y0b, dtype=np.float64), Lp)
-    out = _chunk(pb_np, y0_np, cfg, mesh)
+    static_cfg = dataclasses.replace(cfg, transient_periods=0)  # transient is traced: no recompiles
+    out = _chunk(pb_np, y0_np, jnp.asarray(float(cfg.transient_periods)), static_cfg, mesh)
     out = jax.tree_util.tree_map(lambda x: np.asarray(x)[:L], jax.block_until_ready(out))
     return out
 
@@ -379,7 +394,16 @@ def sweep(
     if out is not None:
         from .dataset import SweepWriter
 
-        writer = SweepWriter(out, params=params, name=name, lane_values=lane_values, lane_y0=lane_y0, n_starts=K, config=cfg, chunks=chunks)
+        writer = SweepWriter(
+            out,
+            params=params,
+            name=name,
+            lane_values=lane_values,
+            lane_y0=lane_y0,
+            n_starts=K,
+            config=cfg,
+            chunks=chunks,
+        )
         done = writer.load_done()
 
     bar = None
@@ -391,7 +415,7 @@ def sweep(
     for ci, idx in enumerate(chunks):
         if ci in results:
             continue
-        pb = jax.tree_util.tree_map(lambda x: np.asarray(x)[idx], pb_all)
+        pb = jax.tree_util.tree_map(lambda x, idx=idx: np.asarray(x)[idx], pb_all)
         t_start = time.perf_counter()
         res = run_lanes(pb, lane_y0[idx], cfg, devices=devices)
         res["_seconds"] = np.full(len(idx), (time.perf_counter() - t_start) / len(idx))
@@ -435,7 +459,15 @@ def bifurcation(
     ``sweep(params, "omega_pi", omega_pi_values, ...)``; see `sweep` for all options. Plot
     ``result.samples[..., 4]`` (omega_2 at the section) against ``result.values``.
     """
-    return sweep(params, "omega_pi", omega_pi_values, transient_periods=transient_periods, sample_periods=sample_periods, y0=y0, **kwargs)
+    return sweep(
+        params,
+        "omega_pi",
+        omega_pi_values,
+        transient_periods=transient_periods,
+        sample_periods=sample_periods,
+        y0=y0,
+        **kwargs,
+    )
 
 
 def continuation(
@@ -479,7 +511,15 @@ def continuation(
 
             it = tqdm(vs, desc=f"continuation {d}", unit="value")
         for v in it:
-            r = sweep(params, name, [v], transient_periods=transient_periods, sample_periods=sample_periods, y0=y[None], **kwargs)
+            r = sweep(
+                params,
+                name,
+                [v],
+                transient_periods=transient_periods,
+                sample_periods=sample_periods,
+                y0=y[None],
+                **kwargs,
+            )
             steps.append(r)
             ok = r.status[0] == 0
             # a failed step restarts the next value from the last good state
@@ -487,3 +527,44 @@ def continuation(
         merged = {k: np.concatenate([getattr(s, k) for s in steps], axis=0) for k in _LANE_FIELDS}
         out[d] = SweepResult(name=name, **merged)
     return out
+
+
+def orbit(
+    params: CeltParams,
+    y0: Any = None,
+    *,
+    transient_periods: int = 200,
+    periods: int = 40,
+    points_per_period: int = 40,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    max_steps: int = 1_000_000,
+    contact_law: AbstractContactLaw | str | None = None,
+) -> dict[str, np.ndarray]:
+    """A densely saved trajectory after the transient, for phase plots (paper Figs. 4-7).
+
+    Saves ``points_per_period`` states per forcing period over ``periods`` periods after
+    ``transient_periods``; save times include the section times exactly (``exact_ts``).
+
+    Returns dict with ``ts`` (n,), ``ys`` (n, 13), ``r_O`` (n, 3) [m], ``section_index``
+    (indices of the section times in ts), ``status``, ``valid``.
+    """
+    if y0 is None:
+        y0 = initial_state(params)
+    w = float(params.omega_pi)
+    T = 2 * np.pi / w
+    k = np.arange(periods * points_per_period + 1)
+    ts = T * (transient_periods + k / points_per_period)
+    sol = simulate(
+        params, y0, ts[-1], ts=ts, rtol=rtol, atol=atol, max_steps=max_steps, contact_law=contact_law, exact_ts=True
+    )
+    ys = np.asarray(sol.ys)
+    r_O = np.asarray(jax.vmap(centre_position, in_axes=(0, None))(sol.ys, params))
+    return dict(
+        ts=ts,
+        ys=ys,
+        r_O=r_O,
+        section_index=np.arange(0, len(ts), points_per_period),
+        status=int(sol.status),
+        valid=bool(sol.valid),
+    )

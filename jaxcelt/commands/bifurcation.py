@@ -1,0 +1,158 @@
+"""``jaxcelt bifurcation``: a stroboscopic sweep -> dataset (netCDF) + figures (PNG) + summary (JSON).
+
+Defaults are a coarse, laptop-sized version of the paper's Fig. 3 (a few minutes on 2 CPU
+cores); the full benchmark size is ``--omega 10:20:400 --transient 200 --sample 100``.
+Interrupting and rerunning the same command resumes from the finished chunks.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "bifurcation",
+        help="stroboscopic bifurcation diagram over omega_pi (or another parameter)",
+        description=__doc__.splitlines()[0],
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+    )
+    p.add_argument("--omega", default="10:20:60", help="omega_pi values [rad/s]: START:STOP:COUNT or a,b,c")
+    p.add_argument("--param", default="omega_pi", help="swept CeltParams field (values from --values)")
+    p.add_argument(
+        "--values", default=None, help="values of --param when it is not omega_pi (START:STOP:COUNT or list)"
+    )
+    p.add_argument("--transient", type=int, default=100, help="transient forcing periods discarded")
+    p.add_argument("--sample", type=int, default=30, help="stroboscopic samples (periods) kept")
+    p.add_argument(
+        "--lyapunov", type=int, default=30, help="periods of tangent dynamics for the Lyapunov exponent (0: off)"
+    )
+    p.add_argument(
+        "--set", action="append", default=[], metavar="NAME=VALUE", help="override any CeltParams field, repeatable"
+    )
+    p.add_argument("--omega0", default="0,0,0", help="initial omega (body) [rad/s]")
+    p.add_argument("--rtol", type=float, default=1e-8)
+    p.add_argument("--atol", type=float, default=1e-10)
+    p.add_argument("--max-steps", type=int, default=1_000_000)
+    p.add_argument("--chunk-size", type=int, default=32, help="lanes per jitted vmapped solve")
+    p.add_argument("--orbits", default="14,15.6,17,19", help="omega_pi values for phase-plot figures ('' for none)")
+    p.add_argument("--orbit-periods", type=int, default=40, help="periods shown in the phase plots")
+    p.add_argument("--out", type=Path, default=Path("out/bifurcation"), help="output directory (resumable)")
+    p.add_argument("--no-figures", action="store_true")
+    p.set_defaults(func=run)
+
+
+def _ranges(ds, key: str = "regime") -> list[dict]:
+    """Contiguous runs of equal (regime label, global motion) along the swept axis."""
+    import numpy as np
+
+    from jaxcelt.regimes import GLOBAL_MOTION, regime_names
+
+    name = ds.attrs["swept_parameter"]
+    vals = ds[name].values
+    reg = ds["regime"].values
+    per = ds["period"].values
+    glob = ds["global_motion"].values
+    if reg.ndim == 2:  # multi-start: first start
+        reg, per, glob = reg[:, 0], per[:, 0], glob[:, 0]
+    labels = [f"{n}, {GLOBAL_MOTION[int(g)]}" for n, g in zip(regime_names(reg, per), glob)]
+    out = []
+    start = 0
+    for i in range(1, len(vals) + 1):
+        if i == len(vals) or labels[i] != labels[start]:
+            out.append({"from": float(vals[start]), "to": float(vals[i - 1]), "n": i - start, "label": labels[start]})
+            start = i
+    lam = ds["lyapunov"].values
+    if np.isfinite(lam).any():
+        out.append({"lyapunov_range_per_s": [float(np.nanmin(lam)), float(np.nanmax(lam))]})
+    return out
+
+
+def run(args) -> int:
+    import numpy as np
+
+    import jaxcelt as jc
+    from jaxcelt.commands.simulate import parse_overrides
+    from jaxcelt.dataset import open_sweep
+    from jaxcelt.sweep import orbit, parse_range, sweep
+    from jaxcelt.versions import versions_string
+
+    print(versions_string(), flush=True)
+    params = jc.CeltParams.paper(**parse_overrides(args.set))
+    values = parse_range(args.omega if args.param == "omega_pi" else (args.values or ""))
+    if values.size == 0:
+        raise SystemExit("no values to sweep (use --omega, or --values with --param)")
+    omega0 = [float(x) for x in args.omega0.split(",")]
+    y0 = np.asarray(jc.initial_state(params, omega=omega0))
+    args.out.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    sweep(
+        params,
+        args.param,
+        values,
+        transient_periods=args.transient,
+        sample_periods=args.sample,
+        lyapunov_periods=args.lyapunov,
+        y0=y0,
+        rtol=args.rtol,
+        atol=args.atol,
+        max_steps=args.max_steps,
+        chunk_size=args.chunk_size,
+        sort_by_cost=True,
+        out=str(args.out),
+        progress=True,
+    )
+    wall = time.perf_counter() - t0
+    ds = open_sweep(args.out)
+    summary = {
+        "command": "jaxcelt bifurcation",
+        "param": args.param,
+        "n_values": int(values.size),
+        "transient_periods": args.transient,
+        "sample_periods": args.sample,
+        "lyapunov_periods": args.lyapunov,
+        "rtol": args.rtol,
+        "atol": args.atol,
+        "wall_seconds_including_compile": round(wall, 2),
+        "lanes_failed": int(np.sum(ds["status"].values != 0)),
+        "lanes_invalid": int(np.sum(ds["valid"].values == 0)),
+        "regimes": _ranges(ds),
+    }
+    (args.out / "summary.json").write_text(json.dumps(summary, indent=1))
+    print(json.dumps(summary, indent=1))
+    if args.no_figures:
+        return 0
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from jaxcelt.plotting.bifurcation import bifurcation_figure, orbit_figure
+
+    fig = bifurcation_figure(ds, color_by="regime")
+    fig.savefig(args.out / "bifurcation_regime.png", dpi=150)
+    plt.close(fig)
+    if np.isfinite(ds["lyapunov"].values).any():
+        fig = bifurcation_figure(ds, color_by="lyapunov")
+        fig.savefig(args.out / "bifurcation_lyapunov.png", dpi=150)
+        plt.close(fig)
+    if args.param == "omega_pi" and args.orbits.strip():
+        for w in parse_range(args.orbits):
+            pw = params.replace(omega_pi=float(w))
+            o = orbit(
+                pw,
+                jc.initial_state(pw, omega=omega0),
+                transient_periods=args.transient,
+                periods=args.orbit_periods,
+                rtol=args.rtol,
+                atol=args.atol,
+            )
+            label = "" if o["valid"] else "model left its validity (lift-off or n3 <= 0)"
+            fig = orbit_figure(o["ts"], o["ys"], o["r_O"], o["section_index"], omega_pi=float(w), label=label)
+            fig.savefig(args.out / f"orbit_omega{w:g}.png", dpi=130)
+            plt.close(fig)
+    print(f"wrote {args.out}", flush=True)
+    return 0

@@ -1,0 +1,127 @@
+"""Sweeps: vmapped lanes equal single `simulate` runs, failing lanes are isolated, sharding is
+transparent, continuation carries states. Compared against `jaxcelt.simulate` (the core
+entry point, not written for the sweep) and against numpy recomputation of the section times."""
+
+import os
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+from _sweep_common import KW, VALUES
+
+import jaxcelt as jc
+from jaxcelt.sweep import bifurcation, continuation, lanes_params, parse_range
+
+
+@pytest.fixture(scope="module")
+def base(paper_params):
+    return bifurcation(paper_params, VALUES, **KW)
+
+
+def test_parse_range():
+    np.testing.assert_array_equal(parse_range("10:20:3"), [10.0, 15.0, 20.0])
+    np.testing.assert_array_equal(parse_range("14,15.6"), [14.0, 15.6])
+    with pytest.raises(ValueError):
+        parse_range("10:20")
+
+
+def test_lanes_params(paper_params):
+    pb = lanes_params(paper_params, "mu", np.array([0.1, 0.2]))
+    assert pb.mu.shape == (2,) and pb.m.shape == (2,)
+    with pytest.raises(ValueError, match="unknown parameter"):
+        lanes_params(paper_params, "nope", np.array([1.0]))
+
+
+def test_sweep_equals_single_simulate(base, paper_params):
+    # Same solver, tolerances and exact section times: a lane of the vmapped chunk must be the
+    # single-trajectory solve up to floating-point reassociation (<= 1e-10 demanded by the issue;
+    # observed ~1e-13, the chaotic lanes amplify roundoff over 7 periods).
+    assert np.all(base.status == 0)
+    for i, w in enumerate(VALUES):
+        p = paper_params.replace(omega_pi=w)
+        T = 2 * np.pi / w
+        ts = T * np.arange(KW["transient_periods"], KW["transient_periods"] + KW["sample_periods"])
+        np.testing.assert_allclose(base.t_samples[i], ts, rtol=1e-15, atol=0)
+        sol = jc.simulate(p, jc.initial_state(p), ts[-1], ts=ts, exact_ts=True, rtol=1e-8, atol=1e-10, max_steps=4000)
+        err = np.max(np.abs(np.asarray(sol.ys) - base.samples[i]))
+        assert err <= 1e-10, (w, err)
+        assert int(sol.num_steps) == int(base.num_steps[i])
+        # N is a stiff function of the state (friction relaxation ~ 3.5e4 1/s): 1e-13 in y
+        # gives ~1e-9 in N, hence the looser tolerance
+        np.testing.assert_allclose(float(sol.validity.min_N), base.min_N[i], rtol=1e-7)
+
+
+def test_failing_lane_is_isolated(base, paper_params):
+    # A lane made stiff (mu = 30: the sticking relaxation rate ~ mu g/(a_hat sqrt(eps)),
+    # MODEL.md section 10, grows 130x) exhausts max_steps; it is flagged and the other lanes
+    # are bitwise unchanged.
+    y0 = np.asarray(jc.initial_state(paper_params))
+    params = paper_params
+    from jaxcelt.sweep import SweepConfig, run_lanes
+
+    cfg = SweepConfig(transient_periods=3, sample_periods=4, max_steps=4000)
+    pb = lanes_params(params, "omega_pi", VALUES)
+    import equinox as eqx
+
+    pb = eqx.tree_at(lambda p: p.mu, pb, np.array([0.2241, 0.2241, 30.0, 0.2241]))
+    out = run_lanes(pb, np.tile(y0, (4, 1)), cfg)
+    assert out["status"][2] == 1  # max_steps reached
+    assert np.all(out["status"][[0, 1, 3]] == 0)
+    for i in (0, 1, 3):
+        assert np.array_equal(out["samples"][i], base.samples[i])  # bitwise
+        assert out["num_steps"][i] == base.num_steps[i]
+
+
+def test_multistart_shapes(paper_params):
+    y0 = np.stack([jc.initial_state(paper_params), jc.initial_state(paper_params, omega=(0.0, 0.0, -2.0))])
+    r = bifurcation(paper_params, VALUES[:2], y0=y0, **KW)  # 2 values x 2 starts = 4 lanes: same chunk shape
+    assert r.samples.shape == (2, 2, KW["sample_periods"], 13)
+    assert r.values.shape == (2, 2)
+    assert not np.allclose(r.samples[:, 0], r.samples[:, 1])
+
+
+def test_bad_inputs(paper_params):
+    with pytest.raises(ValueError):
+        bifurcation(paper_params, [-1.0], transient_periods=1, sample_periods=1)
+    with pytest.raises(ValueError):
+        bifurcation(paper_params, [15.0], transient_periods=1, sample_periods=0)
+
+
+@pytest.mark.slow
+def test_continuation_carries_state(paper_params):
+    res = continuation(paper_params, "omega_pi", [16.0, 16.5], direction="up", transient_periods=2, sample_periods=2)
+    up = res["up"]
+    assert up.samples.shape == (2, 1, 2, 13)
+    # the second value started where the first ended: rerun it by hand from that state
+    p = paper_params.replace(omega_pi=16.5)
+    T = 2 * np.pi / 16.5
+    ts = T * np.arange(2, 4)
+    sol = jc.simulate(p, up.y_final[0, 0], ts[-1], ts=ts, exact_ts=True)
+    assert np.max(np.abs(np.asarray(sol.ys) - up.samples[1, 0])) <= 1e-10
+
+
+@pytest.mark.slow
+def test_two_host_devices_equal_one():
+    # Forced 2 CPU devices (XLA flag) in a fresh process: the sharded chunk must equal the
+    # one-device chunk. Both run in the same process so only the device count differs.
+    code = textwrap.dedent(
+        """
+        import jax, numpy as np, jaxcelt as jc
+        from jaxcelt.sweep import bifurcation
+        assert len(jax.local_devices()) == 2, jax.local_devices()
+        p = jc.CeltParams.paper()
+        v = np.array([12.0, 14.0, 17.0, 19.0])
+        kw = dict(transient_periods=3, sample_periods=4, max_steps=4000, chunk_size=4)
+        a = bifurcation(p, v, **kw)
+        b = bifurcation(p, v, devices=jax.local_devices()[:1], **kw)
+        print("MAXDIFF", float(np.max(np.abs(a.samples - b.samples))), bool(np.array_equal(a.samples, b.samples)))
+        """
+    )
+    env = dict(os.environ, XLA_FLAGS="--xla_force_host_platform_device_count=2")
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-3000:]
+    line = [s for s in out.stdout.splitlines() if s.startswith("MAXDIFF")][0]
+    maxdiff = float(line.split()[1])
+    assert maxdiff <= 1e-12, line
