@@ -1,0 +1,799 @@
+"""Gradient-based identification of model parameters from measured trajectories.
+
+The unknowns are the free parameters, mapped to an unconstrained vector z by per-parameter
+transforms (`Positive`: theta = theta0 exp(z); `Bounded(lo, hi)`: a scaled logistic; `Affine`:
+theta = theta0 + scale z), and -- with multiple shooting -- the initial states of the windows.
+
+Residuals r(z) (all dimensionless, stacked into one vector):
+
+* misfit: (h(y(t_j)) - d_j) / sigma for every sample j, observation kind and channel, times
+  sqrt(weight[kind]); h is the observation model (`jaxcelt.data.observe`);
+* continuity (multiple shooting): (y_k(end of window k) - s_{k+1}) / state_scale times
+  sqrt(continuity_weight), where s_{k+1} is the next window's (projected) initial state;
+* gauge (optimised window states): (s - P(s)) / state_scale times sqrt(continuity_weight), P the
+  projection onto the contact manifold (`project_state`), which pins the three directions of the
+  13-vector that the projection removes.
+
+loss = 1/2 |r|^2. Optimisers: ``"lm"`` (optimistix Levenberg-Marquardt, forward-mode Jacobians via
+``diffrax.ForwardMode``), ``"gn"`` (optimistix Gauss-Newton), ``"adam"`` and ``"lbfgs"`` (optax,
+reverse-mode gradients). Uncertainty (`FitResult.stderr`, ``ci95``, ``corr``): the Gauss-Newton
+approximation cov(z) = s^2 (J^T J)^-1 at the optimum with s^2 = RSS_misfit / (n_data - n_unknowns),
+marginalised over the window states, mapped to the physical parameters by the delta method.
+
+Multiple shooting splits each record into ``windows`` windows of equal sample count; each is
+integrated from its own initial state, so the sensitivity of the loss to the unknowns grows like
+e^{lambda T_window} instead of e^{lambda T_record} (lambda: largest Lyapunov exponent) -- the
+remedy for long and chaotic records (see `gradient_norm_vs_window`, `finite_time_lyapunov`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import diffrax
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optax
+import optimistix as optx
+
+from . import _config  # noqa: F401
+from ._types import Array, State
+from .data import OBSERVABLES, MeasuredData, observe
+from .model import contact_geometry
+from .params import PARAM_NAMES, CeltParams
+from .solve import simulate
+
+__all__ = [
+    "fit",
+    "FitResult",
+    "Positive",
+    "Bounded",
+    "Affine",
+    "DEFAULT_TRANSFORMS",
+    "STATE_SCALE",
+    "OPTIMISERS",
+    "project_state",
+    "predict",
+    "finite_time_lyapunov",
+    "gradient_norm_vs_window",
+]
+
+OPTIMISERS = ("lm", "gn", "adam", "lbfgs")
+
+STATE_SCALE = np.array([0.1, 0.1, 0.1, 1.0, 1.0, 1.0, 0.1, 0.1, 0.1, 0.01, 0.01, 0.01, 0.1])
+"""Typical size of a change of each state component (v [m/s], omega [rad/s], n [-], r_C [m],
+psi [rad]); scales the optimised window states and the continuity/gauge residuals."""
+
+
+# ----------------------------------------------------------------------------- transforms
+class Positive(eqx.Module):
+    """theta = theta0 exp(z): keeps theta > 0; z is the log relative change."""
+
+    def forward(self, z, theta0):
+        return theta0 * jnp.exp(z)
+
+    def inverse(self, theta, theta0):
+        return jnp.log(theta / theta0)
+
+
+class Bounded(eqx.Module):
+    """lo < theta < hi via theta = lo + (hi - lo) sigmoid(z + logit((theta0 - lo)/(hi - lo)))."""
+
+    lo: float = eqx.field(static=True)
+    hi: float = eqx.field(static=True)
+
+    def _c(self, theta0):
+        u = (theta0 - self.lo) / (self.hi - self.lo)
+        return jnp.log(u / (1 - u))
+
+    def forward(self, z, theta0):
+        return self.lo + (self.hi - self.lo) * jax.nn.sigmoid(z + self._c(theta0))
+
+    def inverse(self, theta, theta0):
+        u = (theta - self.lo) / (self.hi - self.lo)
+        return jnp.log(u / (1 - u)) - self._c(theta0)
+
+
+class Affine(eqx.Module):
+    """theta = theta0 + scale z (signed parameters such as B12 or k3); scale defaults to |theta0|
+    (or 1 if theta0 = 0)."""
+
+    scale: float | None = eqx.field(static=True, default=None)
+
+    def _s(self, theta0):
+        if self.scale is not None:
+            return self.scale
+        return jnp.where(theta0 == 0, 1.0, jnp.abs(theta0))
+
+    def forward(self, z, theta0):
+        return theta0 + self._s(theta0) * z
+
+    def inverse(self, theta, theta0):
+        return (theta - theta0) / self._s(theta0)
+
+
+DEFAULT_TRANSFORMS: dict[str, Any] = {
+    "m_Ts": Bounded(0.0, 2.0),
+    "m_Ms": Bounded(0.0, 2.0),
+    "b": Bounded(0.0, 1.0),
+    "B12": Affine(),
+    "B13": Affine(),
+    "B23": Affine(),
+    "k1": Affine(),
+    "k2": Affine(),
+    "k3": Affine(),
+}
+"""Transform per parameter name; any other free parameter is `Positive`. The generalised Pade
+exponents live in (0, 2] (the brief's 0 < m <= 2), b in (0, 1]."""
+
+_NOT_FREE = ("v_pi_sign", "derivative_exact", "omega_pi", "q_pi")
+
+
+# ----------------------------------------------------------------------------- state helpers
+def project_state(y: State, params: CeltParams) -> State:
+    """Project a 13-vector onto the contact manifold (MODEL.md section 8).
+
+    Normalises n, removes the normal component of the contact-point velocity v_A = v + omega x rho
+    (eq. 2) and sets r_C3 to the height of C above the contact (-rho . n). Differentiable.
+    """
+    v, w, n, r_C, psi = y[0:3], y[3:6], y[6:9], y[9:12], y[12:13]
+    n = n / jnp.linalg.norm(n)
+    rho = contact_geometry(n, w, params).rho
+    v_A = v + jnp.cross(w, rho)
+    v_A = v_A - jnp.dot(v_A, n) * n
+    v = v_A - jnp.cross(w, rho)
+    r_C = r_C.at[2].set(-jnp.dot(rho, n))
+    return jnp.concatenate([v, w, n, r_C, psi])
+
+
+# ----------------------------------------------------------------------------- the problem
+class _Record(eqx.Module):
+    """One trajectory cut into K windows of n+1 samples (shared boundary samples)."""
+
+    ts: Array  # (K, n+1)
+    obs: dict  # kind -> (K, n+1, k)
+    inv_sigma: dict  # kind -> (k,)
+    fixed_states: Array  # (K, 13) states of windows that are not optimised
+    omega_pi: Array
+    q_pi: Array
+    free_windows: tuple[int, ...] = eqx.field(static=True)
+
+
+class _Problem(eqx.Module):
+    """Residual function of a fit; a pytree so that jit caches across fits of the same shape."""
+
+    params0: CeltParams
+    theta0: Array  # (P,)
+    records: tuple[_Record, ...]
+    weights: dict  # kind -> scalar
+    continuity_weight: Array
+    free: tuple[str, ...] = eqx.field(static=True)
+    transforms: tuple[Any, ...] = eqx.field(static=True)
+    kinds: tuple[str, ...] = eqx.field(static=True)
+    mode: str = eqx.field(static=True)  # "fwd" | "rev"
+    rtol: float = eqx.field(static=True)
+    atol: float = eqx.field(static=True)
+    max_steps: int = eqx.field(static=True)
+
+    def theta(self, zp: Array) -> Array:
+        return jnp.stack([tr.forward(zp[i], self.theta0[i]) for i, tr in enumerate(self.transforms)])
+
+    def params(self, zp: Array) -> CeltParams:
+        th = self.theta(zp)
+        names = self.free
+        return eqx.tree_at(lambda p: [getattr(p, n) for n in names], self.params0, [th[i] for i in range(len(names))])
+
+    def window_states(self, z, i: int) -> Array:
+        rec = self.records[i]
+        s = rec.fixed_states
+        if rec.free_windows:
+            s = s.at[jnp.array(rec.free_windows)].set(z["states"][i] * STATE_SCALE)
+        return s
+
+    def simulate_windows(self, z, i: int) -> tuple[Array, Array]:
+        """States (K, n+1, 13) in every window of record i, and the solver status (K,)."""
+        rec = self.records[i]
+        p = self.params(z["params"])
+        p = eqx.tree_at(lambda q: (q.omega_pi, q.q_pi), p, (rec.omega_pi, rec.q_pi))
+        s = jax.vmap(lambda y: project_state(y, p))(self.window_states(z, i))
+        adjoint = diffrax.ForwardMode() if self.mode == "fwd" else diffrax.RecursiveCheckpointAdjoint()
+
+        def one(y0, ts):
+            sol = simulate(
+                p,
+                y0,
+                ts[-1],
+                t0=ts[0],
+                ts=ts,
+                rtol=self.rtol,
+                atol=self.atol,
+                max_steps=self.max_steps,
+                adjoint=adjoint,
+            )
+            return sol.ys, sol.status
+
+        return jax.vmap(one)(s, rec.ts)
+
+    def residuals(self, z, args=None) -> tuple[Array, dict]:
+        """(r (M,), aux) with aux = {"misfit": data-part RSS, "continuity": penalty RSS}."""
+        p = self.params(z["params"])
+        mis, pen = [], []
+        for i, rec in enumerate(self.records):
+            ys, status = self.simulate_windows(z, i)
+            pr = eqx.tree_at(lambda q: (q.omega_pi, q.q_pi), p, (rec.omega_pi, rec.q_pi))
+            for kind in rec.obs:
+                h = jax.vmap(jax.vmap(lambda y, kind=kind, pr=pr: observe(y, pr, kind)))(ys)
+                r = (h - rec.obs[kind]) * rec.inv_sigma[kind] * jnp.sqrt(self.weights[kind])
+                # window k>0 starts at the previous window's last sample: count it once
+                mis.append(jnp.concatenate([r[0].reshape(-1), r[1:, 1:].reshape(-1)]))
+            K = ys.shape[0]
+            if K > 1:
+                starts = jax.vmap(lambda y, pr=pr: project_state(y, pr))(self.window_states(z, i))
+                c = (ys[:-1, -1] - starts[1:]) / STATE_SCALE
+                pen.append(c.reshape(-1) * jnp.sqrt(self.continuity_weight))
+            if rec.free_windows:
+                raw = z["states"][i] * STATE_SCALE
+                g = (raw - jax.vmap(lambda y, pr=pr: project_state(y, pr))(raw)) / STATE_SCALE
+                pen.append(g.reshape(-1) * jnp.sqrt(self.continuity_weight))
+        rm = jnp.concatenate(mis)
+        rp = jnp.concatenate(pen) if pen else jnp.zeros(0)
+        # a failed or diverging solve gives inf/NaN samples: a large finite residual lets the
+        # optimiser reject the step instead of poisoning its state
+        rm = jnp.where(jnp.isfinite(rm), rm, 1e6)
+        rp = jnp.where(jnp.isfinite(rp), rp, 1e6)
+        return jnp.concatenate([rm, rp]), {"misfit": jnp.sum(rm**2), "continuity": jnp.sum(rp**2)}
+
+    def loss(self, z) -> Array:
+        return 0.5 * jnp.sum(self.residuals(z)[0] ** 2)
+
+    # -- flat interface for the least-squares solvers ---------------------------------------
+    def unflatten(self, zf: Array) -> dict:
+        P = len(self.free)
+        states, i = [], P
+        for rec in self.records:
+            k = len(rec.free_windows)
+            states.append(zf[i : i + 13 * k].reshape(k, 13))
+            i += 13 * k
+        return {"params": zf[:P], "states": tuple(states)}
+
+    def value_and_jacobian(self, zf: Array) -> tuple[Array, Array]:
+        """r (M,) and the forward-mode Jacobian dr/dz (M, len(zf)) in one batched JVP pass."""
+        f = lambda x: self.residuals(self.unflatten(x))[0]
+        J, r = jax.jacfwd(lambda x: (f(x), f(x)), has_aux=True)(zf)
+        return r, J
+
+    def flat_residuals(self, zf: Array, args=None) -> Array:
+        """r(z) for optimistix. Its JVP is J dz with J from `value_and_jacobian`, so that the
+        solver's linearisation costs one batched forward pass per iteration instead of one
+        re-simulation per materialised column."""
+
+        @jax.custom_jvp
+        def res(x):
+            return self.residuals(self.unflatten(x))[0]
+
+        @res.defjvp
+        def res_jvp(primals, tangents):
+            r, J = self.value_and_jacobian(primals[0])
+            return r, J @ tangents[0]
+
+        return res(zf)
+
+
+# ----------------------------------------------------------------------------- result
+@dataclasses.dataclass
+class FitResult:
+    """Outcome of `fit`. Physical values are floats; arrays are numpy.
+
+    values/params: fitted free parameters (name -> value) / full `CeltParams`; stderr, ci95
+    (name -> (lo, hi)): Gauss-Newton standard errors and 95% intervals (theta +- 1.96 se);
+    corr (P, P): correlation matrix of the free parameters; s2: residual variance factor;
+    loss_history, param_history (iteration -> loss, dict of values); wall_time [s] of the
+    optimisation after compilation, compile_time [s] of the first iteration, total_time [s];
+    n_iter; converged: the optimiser's own criterion (LM/GN) or the loss/step criterion (optax).
+    z: final unknowns; problem: the residual function (for `predict`, plotting).
+    """
+
+    free: tuple[str, ...]
+    values: dict[str, float]
+    params: CeltParams
+    stderr: dict[str, float]
+    ci95: dict[str, tuple[float, float]]
+    corr: np.ndarray
+    cov: np.ndarray
+    s2: float
+    loss: float
+    misfit: float
+    continuity: float
+    n_data: int
+    n_unknowns: int
+    loss_history: list[float]
+    param_history: list[dict[str, float]]
+    n_iter: int
+    converged: bool
+    optimiser: str
+    windows: int
+    wall_time: float
+    compile_time: float
+    total_time: float
+    z: Any = None
+    problem: Any = None
+
+    def relative_error(self, true: dict[str, float] | CeltParams) -> dict[str, float]:
+        """|fitted - true| / |true| per free parameter."""
+        get = (lambda n: float(getattr(true, n))) if isinstance(true, CeltParams) else (lambda n: float(true[n]))
+        return {n: abs(self.values[n] - get(n)) / abs(get(n)) for n in self.free}
+
+    def covers(self, true: dict[str, float] | CeltParams) -> dict[str, bool]:
+        """Whether each true value lies in the reported 95% interval."""
+        get = (lambda n: float(getattr(true, n))) if isinstance(true, CeltParams) else (lambda n: float(true[n]))
+        return {n: self.ci95[n][0] <= get(n) <= self.ci95[n][1] for n in self.free}
+
+    def summary(self) -> str:
+        lines = [
+            f"optimiser {self.optimiser}, windows {self.windows}: {self.n_iter} iterations, converged={self.converged}, "
+            f"loss {self.loss:.6g} (misfit RSS {self.misfit:.6g}, continuity {self.continuity:.3g}), s^2 = {self.s2:.4g}",
+            f"time: compile {self.compile_time:.2f} s, run {self.wall_time:.2f} s",
+        ]
+        for n in self.free:
+            lo, hi = self.ci95[n]
+            lines.append(f"  {n:>8s} = {self.values[n]:.6g} +- {self.stderr[n]:.3g}  (95%: [{lo:.6g}, {hi:.6g}])")
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict:
+        """JSON-serialisable summary (no arrays of the problem)."""
+        return dict(
+            free=list(self.free),
+            values=self.values,
+            stderr=self.stderr,
+            ci95={k: list(v) for k, v in self.ci95.items()},
+            corr=np.asarray(self.corr).tolist(),
+            s2=self.s2,
+            loss=self.loss,
+            misfit=self.misfit,
+            continuity=self.continuity,
+            n_data=self.n_data,
+            n_unknowns=self.n_unknowns,
+            loss_history=list(map(float, self.loss_history)),
+            param_history=self.param_history,
+            n_iter=self.n_iter,
+            converged=self.converged,
+            optimiser=self.optimiser,
+            windows=self.windows,
+            wall_time=self.wall_time,
+            compile_time=self.compile_time,
+            total_time=self.total_time,
+        )
+
+
+# ----------------------------------------------------------------------------- building
+def _build(
+    data: MeasuredData,
+    params0: CeltParams,
+    free: tuple[str, ...],
+    transforms: dict,
+    weights: dict,
+    windows: int,
+    window_states: str,
+    fit_y0: bool,
+    continuity_weight: float,
+    mode: str,
+    rtol: float,
+    atol: float,
+    max_steps: int,
+) -> tuple[_Problem, dict]:
+    trs = []
+    for n in free:
+        if n not in PARAM_NAMES:
+            raise ValueError(f"fit: unknown parameter {n!r}; known: {PARAM_NAMES}")
+        if n in _NOT_FREE:
+            raise ValueError(f"fit: {n!r} is a reading switch or a per-record forcing value and cannot be fitted")
+        trs.append(transforms.get(n, DEFAULT_TRANSFORMS.get(n, Positive())))
+    if len(set(free)) != len(free) or not free:
+        raise ValueError(f"fit: 'free' must be a non-empty tuple of distinct names, got {free}")
+    if windows < 1:
+        raise ValueError(f"fit: windows must be >= 1, got {windows}")
+    if window_states not in ("data", "optimise"):
+        raise ValueError(f"fit: window_states must be 'data' or 'optimise', got {window_states!r}")
+    theta0 = jnp.stack([jnp.asarray(getattr(params0, n), float) for n in free])
+    kinds_all: set[str] = set()
+    records, z_states = [], []
+    for it, tr in enumerate(data.trajectories):
+        T = tr.ts.size
+        n = (T - 1) // windows
+        if n < 1:
+            raise ValueError(f"fit: trajectory {it} has {T} samples, too few for {windows} windows")
+        idx = np.arange(windows)[:, None] * n + np.arange(n + 1)[None, :]  # (K, n+1); tail samples dropped
+        p_tr = params0.replace(omega_pi=tr.omega_pi, q_pi=tr.q_pi)
+        state_obs = tr.obs.get("state")
+        # window initial states: from the data (projected), a known y0, or a simulation at params0
+        starts = np.full((windows, 13), np.nan)
+        if tr.y0 is not None:
+            starts[0] = tr.y0
+        elif state_obs is not None:
+            starts[0] = np.asarray(project_state(jnp.asarray(state_obs[0]), p_tr))
+        elif not fit_y0:
+            raise ValueError(
+                f"fit: trajectory {it} has no known y0 and no state observations; pass fit_y0=True with a y0 guess"
+            )
+        if windows > 1:
+            if state_obs is not None:
+                for k in range(1, windows):
+                    starts[k] = np.asarray(project_state(jnp.asarray(state_obs[idx[k, 0]]), p_tr))
+            elif window_states == "data":
+                raise ValueError("fit: window_states='data' needs full-state observations")
+            else:
+                if np.isnan(starts[0]).any():
+                    raise ValueError(f"fit: trajectory {it}: need y0 to initialise the window states")
+                sol = simulate(
+                    p_tr,
+                    jnp.asarray(starts[0]),
+                    float(tr.ts[idx[-1, 0]]),
+                    ts=jnp.asarray(tr.ts[idx[:, 0]]),
+                    rtol=rtol,
+                    atol=atol,
+                )
+                starts[1:] = np.asarray(sol.ys)[1:]
+        free_w = []
+        if fit_y0:
+            free_w.append(0)
+        if windows > 1 and window_states == "optimise":
+            free_w += list(range(1, windows))
+        fixed = np.where(np.isnan(starts), 0.0, starts)
+        records.append(
+            _Record(
+                ts=jnp.asarray(tr.ts[idx]),
+                obs={k: jnp.asarray(tr.obs[k][idx]) for k in tr.kinds},
+                inv_sigma={k: jnp.asarray(1.0 / tr.sigma[k]) for k in tr.kinds},
+                fixed_states=jnp.asarray(fixed),
+                omega_pi=jnp.asarray(tr.omega_pi),
+                q_pi=jnp.asarray(tr.q_pi),
+                free_windows=tuple(free_w),
+            )
+        )
+        z_states.append(jnp.asarray(fixed[free_w] / STATE_SCALE) if free_w else jnp.zeros((0, 13)))
+        kinds_all |= set(tr.kinds)
+    w = {k: jnp.asarray(float(weights.get(k, 1.0))) for k in sorted(kinds_all)}
+    prob = _Problem(
+        params0=params0,
+        theta0=theta0,
+        records=tuple(records),
+        weights=w,
+        continuity_weight=jnp.asarray(float(continuity_weight)),
+        free=tuple(free),
+        transforms=tuple(trs),
+        kinds=tuple(sorted(kinds_all)),
+        mode=mode,
+        rtol=rtol,
+        atol=atol,
+        max_steps=max_steps,
+    )
+    z0 = {"params": jnp.zeros(len(free)), "states": tuple(z_states)}
+    return prob, z0
+
+
+# ----------------------------------------------------------------------------- optimisers (jitted once per shape)
+@eqx.filter_jit
+def _residuals(prob: _Problem, z):
+    return prob.residuals(z)
+
+
+@eqx.filter_jit
+def _value_and_jacobian(prob: _Problem, zf):
+    return dataclasses.replace(prob, mode="fwd").value_and_jacobian(zf)
+
+
+@eqx.filter_jit
+def _lsq_jac(state):
+    # Jacobian at the last accepted iterate, kept by optimistix as a linear operator (with the
+    # custom JVP of `_Problem.flat_residuals` it is J @ dz, so materialising it is cheap)
+    return state.f_info.jac.as_matrix()
+
+
+def _lsq_solver(name, rtol, atol):
+    if name == "lm":
+        return optx.LevenbergMarquardt(rtol=rtol, atol=atol)
+    return optx.GaussNewton(rtol=rtol, atol=atol)
+
+
+def _lsq_fn(prob):
+    return lambda zf, args: (prob.flat_residuals(zf), None)
+
+
+@eqx.filter_jit
+def _lsq_init(prob, z, solver):
+    fn = _lsq_fn(prob)
+    f_struct, aux_struct = jax.eval_shape(fn, z, None)
+    return solver.init(fn, z, None, {}, f_struct, aux_struct, frozenset())
+
+
+@eqx.filter_jit
+def _lsq_step(prob, z, state, solver):
+    fn = _lsq_fn(prob)
+    z, state, _ = solver.step(fn, z, None, {}, state, frozenset())
+    done, result = solver.terminate(fn, z, None, {}, state, frozenset())
+    # loss at the last accepted iterate
+    return z, state, 0.5 * jnp.sum(state.f_info.residual**2), done, result
+
+
+@eqx.filter_jit
+def _optax_step(prob, z, opt_state, optimiser):
+    loss_fn = prob.loss
+    value, grad = jax.value_and_grad(loss_fn)(z)
+    if isinstance(optimiser, optax.GradientTransformationExtraArgs):
+        updates, opt_state = optimiser.update(grad, opt_state, z, value=value, grad=grad, value_fn=loss_fn)
+    else:
+        updates, opt_state = optimiser.update(grad, opt_state, z)
+    z_new = optax.apply_updates(z, updates)
+    return z_new, opt_state, value, optax.tree.norm(grad)
+
+
+def fit(
+    data: MeasuredData,
+    params0: CeltParams,
+    *,
+    free: Sequence[str] = ("mu", "k_r", "b_Ts", "m_Ts"),
+    optimiser: str = "lm",
+    weights: dict[str, float] | None = None,
+    transforms: dict[str, Any] | None = None,
+    windows: int = 1,
+    window_states: str = "optimise",
+    fit_y0: bool = False,
+    continuity_weight: float = 1e4,
+    max_iter: int = 100,
+    rtol: float = 1e-8,
+    atol: float = 1e-8,
+    sim_rtol: float = 1e-8,
+    sim_atol: float = 1e-10,
+    max_steps: int = 200_000,
+    learning_rate: float = 0.02,
+    uncertainty: bool = True,
+    callback: Callable[[int, float, dict[str, float]], None] | None = None,
+) -> FitResult:
+    """Fit the free parameters to measured trajectories.
+
+    Args:
+        data: `jaxcelt.data.MeasuredData` (any observation kinds; several records, each with its
+            own omega_pi, q_pi).
+        params0: starting parameters (also the values of every parameter that is not free).
+        free: names of the parameters to fit (any float fields of `CeltParams` except the
+            reading switches and the per-record omega_pi, q_pi).
+        optimiser: ``"lm"`` (optimistix Levenberg-Marquardt), ``"gn"`` (Gauss-Newton), both with
+            forward-mode Jacobians; ``"adam"`` or ``"lbfgs"`` (optax, reverse-mode gradients).
+        weights: extra weight per observation kind (default 1; residuals are already /sigma).
+        transforms: per-parameter transforms overriding `DEFAULT_TRANSFORMS` (else `Positive`).
+        windows: number of multiple-shooting windows per record (1 = single shooting).
+        window_states: ``"optimise"`` (window initial states are unknowns, initialised from the
+            data or from a simulation at params0, tied by the continuity penalty) or ``"data"``
+            (fixed to the projected measured states; needs ``"state"`` observations).
+        fit_y0: also optimise the first window's initial state (else: the record's known y0, or
+            its first projected full-state sample).
+        continuity_weight: weight of the continuity and gauge residuals (residual scale
+            `STATE_SCALE` / sqrt(weight)).
+        max_iter: iteration budget. rtol, atol: optimistix termination (relative/absolute change
+            of z and of the loss); optax optimisers stop when the relative loss change < rtol
+            over 5 iterations.
+        sim_rtol, sim_atol, max_steps: integrator settings.
+        learning_rate: Adam step size in z (log-relative units for `Positive` parameters).
+        uncertainty: compute standard errors, intervals and correlations.
+        callback: called as ``callback(iteration, loss, values)`` after each iteration (progress).
+
+    Returns:
+        `FitResult`.
+    """
+    if optimiser not in OPTIMISERS:
+        raise ValueError(f"fit: optimiser must be one of {OPTIMISERS}, got {optimiser!r}")
+    mode = "fwd" if optimiser in ("lm", "gn") else "rev"
+    free = tuple(free)
+    prob, z = _build(
+        data,
+        params0,
+        free,
+        transforms or {},
+        weights or {},
+        windows,
+        window_states,
+        fit_y0,
+        continuity_weight,
+        mode,
+        sim_rtol,
+        sim_atol,
+        max_steps,
+    )
+    t_start = time.perf_counter()  # includes _lsq_init's compilation in the first mark
+
+    def values_of(zz) -> dict[str, float]:
+        zp = zz["params"] if isinstance(zz, dict) else zz[: len(free)]
+        th = np.asarray(prob.theta(zp))
+        return {n: float(th[i]) for i, n in enumerate(free)}
+
+    loss_hist, par_hist = [], []
+    converged = False
+    lsq_state = None
+    iter_marks = [time.perf_counter()]
+    compile_time = 0.0
+    if mode == "fwd":
+        z = jnp.concatenate([z["params"], *[s.reshape(-1) for s in z["states"]]])
+        solver = _lsq_solver(optimiser, rtol, atol)
+        state = _lsq_init(prob, z, solver)
+        for it in range(max_iter):
+            z_new, state, loss_acc, done, result = _lsq_step(prob, z, state, solver)
+            jax.block_until_ready(z_new)
+            iter_marks.append(time.perf_counter())
+            # optimistix reports the loss of the point it evaluated; track the accepted iterate
+            z = z_new
+            loss_hist.append(float(loss_acc))
+            par_hist.append(values_of(z))
+            if callback is not None:
+                callback(it, loss_hist[-1], par_hist[-1])
+            if bool(done):
+                converged = result == optx.RESULTS.successful
+                break
+        z = prob.unflatten(z)
+        lsq_state = state
+    else:
+        if optimiser == "adam":
+            opt = optax.adam(learning_rate)
+        else:
+            opt = optax.lbfgs()
+        opt_state = opt.init(z)
+        for it in range(max_iter):
+            z_new, opt_state, value, gnorm = _optax_step(prob, z, opt_state, opt)
+            jax.block_until_ready(z_new)
+            iter_marks.append(time.perf_counter())
+            loss_hist.append(float(value))
+            par_hist.append(values_of(z))
+            if callback is not None:
+                callback(it, loss_hist[-1], par_hist[-1])
+            z = z_new
+            if not np.isfinite(float(value)):
+                break
+            if it >= 5 and abs(loss_hist[-6] - loss_hist[-1]) <= rtol * abs(loss_hist[-1]) + 1e-14:
+                converged = True
+                break
+    loop_time = time.perf_counter() - t_start
+    iter_times = np.diff(np.asarray(iter_marks))
+    typical = float(np.median(iter_times[1:])) if iter_times.size > 1 else 0.0
+    # the first iteration pays for compilation; count it as a typical iteration in the run time
+    compile_time = max(float(iter_times[0]) - typical, 0.0) if iter_times.size else 0.0
+    wall = loop_time - compile_time
+    n_data = sum(_count(rec, k) for rec in prob.records for k in rec.obs)
+    zf = jnp.concatenate([z["params"], *[s.reshape(-1) for s in z["states"]]])
+    Jflat = None
+    if mode == "fwd" and lsq_state is not None:
+        r = np.asarray(lsq_state.f_info.residual)
+        if uncertainty:
+            Jflat = np.asarray(_lsq_jac(lsq_state))
+    elif uncertainty:
+        r, Jflat = (np.asarray(a) for a in _value_and_jacobian(prob, zf))
+    else:
+        r = np.asarray(_residuals(prob, z)[0])
+    misfit, cont = float(np.sum(r[:n_data] ** 2)), float(np.sum(r[n_data:] ** 2))
+    loss_hist.append(0.5 * (misfit + cont))
+    par_hist.append(values_of(z))
+    n_unk = int(zf.size)
+    P = len(free)
+    values = values_of(z)
+    stderr = dict.fromkeys(free, np.nan)
+    ci = {n: (np.nan, np.nan) for n in free}
+    cov = np.full((P, P), np.nan)
+    corr = np.full((P, P), np.nan)
+    s2 = np.nan
+    if uncertainty:
+        dof = max(n_data - (n_unk - 3 * sum(len(rec.free_windows) for rec in prob.records)), 1)
+        s2 = misfit / dof
+        H = Jflat.T @ Jflat
+        cov_z = s2 * np.linalg.pinv(H, rcond=1e-13, hermitian=True)[:P, :P]
+        dth = np.asarray(jax.jacfwd(prob.theta)(z["params"]))
+        cov = dth @ cov_z @ dth.T
+        se = np.sqrt(np.maximum(np.diag(cov), 0.0))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            corr = cov / np.outer(se, se)
+        for i, nme in enumerate(free):
+            stderr[nme] = float(se[i])
+            ci[nme] = (values[nme] - 1.96 * float(se[i]), values[nme] + 1.96 * float(se[i]))
+    total = time.perf_counter() - t_start
+    return FitResult(
+        free=free,
+        values=values,
+        params=prob.params(z["params"]),
+        stderr=stderr,
+        ci95=ci,
+        corr=corr,
+        cov=cov,
+        s2=float(s2),
+        loss=0.5 * (misfit + cont),
+        misfit=misfit,
+        continuity=cont,
+        n_data=n_data,
+        n_unknowns=n_unk,
+        loss_history=loss_hist,
+        param_history=par_hist,
+        n_iter=len(loss_hist) - 1,
+        converged=bool(converged),
+        optimiser=optimiser,
+        windows=windows,
+        wall_time=wall,
+        compile_time=compile_time,
+        total_time=total,
+        z=z,
+        problem=prob,
+    )
+
+
+def _count(rec: _Record, kind: str) -> int:
+    K, n1, k = rec.obs[kind].shape
+    return (n1 + (K - 1) * (n1 - 1)) * k
+
+
+def predict(result: FitResult) -> list[dict[str, Any]]:
+    """Fitted trajectories per record: [{"ts": (K, n+1), "ys": (K, n+1, 13), kind: (K, n+1, k)}].
+
+    Windows are simulated from their fitted initial states (one window = single shooting).
+    """
+    prob, z = result.problem, result.z
+    out = []
+    for i, rec in enumerate(prob.records):
+        ys, _ = eqx.filter_jit(lambda pr, zz, i=i: pr.simulate_windows(zz, i))(dataclasses.replace(prob, mode="rev"), z)
+        p = prob.params(z["params"])
+        p = eqx.tree_at(lambda q: (q.omega_pi, q.q_pi), p, (rec.omega_pi, rec.q_pi))
+        d = {"ts": np.asarray(rec.ts), "ys": np.asarray(ys)}
+        for kind in OBSERVABLES:
+            d[kind] = np.asarray(jax.vmap(jax.vmap(lambda y, kind=kind, p=p: observe(y, p, kind)))(ys))
+        d["data"] = {k: np.asarray(v) for k, v in rec.obs.items()}
+        out.append(d)
+    return out
+
+
+# ----------------------------------------------------------------------------- chaos diagnostics
+def finite_time_lyapunov(
+    params: CeltParams, y0: State, t1: float, *, n_samples: int = 50, seed: int = 0
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """Growth of a random initial perturbation along a trajectory (forward-mode tangent).
+
+    Returns (ts (n,), log|delta y(t)| (n,), lambda [1/s]): lambda is the least-squares slope of
+    the log tangent norm over the second half of the record (a finite-time estimate of the
+    largest Lyapunov exponent). The perturbation is tangent to the contact manifold.
+    """
+    ts = jnp.linspace(0.0, t1, n_samples)
+    rng = np.random.default_rng(seed)
+    d = jnp.asarray(rng.standard_normal(13) * STATE_SCALE)
+
+    def traj(y):
+        return simulate(params, project_state(y, params), t1, ts=ts, adjoint=diffrax.ForwardMode()).ys
+
+    _, tang = jax.jvp(traj, (jnp.asarray(y0),), (d,))
+    lg = np.log(np.linalg.norm(np.asarray(tang) / STATE_SCALE, axis=1))
+    tsn = np.asarray(ts)
+    h = n_samples // 2
+    lam = float(np.polyfit(tsn[h:], lg[h:], 1)[0])
+    return tsn, lg, lam
+
+
+def gradient_norm_vs_window(
+    data: MeasuredData,
+    params0: CeltParams,
+    lengths: Sequence[int],
+    *,
+    free: Sequence[str] = ("mu", "k_r", "b_Ts", "m_Ts"),
+) -> tuple[np.ndarray, np.ndarray]:
+    """|d loss / d z_params| of a single-shooting fit on the first ``L`` samples of record 0.
+
+    Args: data, params0, lengths: window lengths in samples. Returns (T [s] (L,), gradient
+    norms (L,)); compare with e^{lambda T} from `finite_time_lyapunov`.
+    """
+    tr = data.trajectories[0]
+    Ts, norms = [], []
+    for L in lengths:
+        sub = dataclasses.replace(tr, ts=tr.ts[: L + 1], obs={k: v[: L + 1] for k, v in tr.obs.items()})
+        prob, z = _build(
+            MeasuredData((sub,)), params0, tuple(free), {}, {}, 1, "data", False, 1.0, "rev", 1e-8, 1e-10, 200_000
+        )
+        g = eqx.filter_jit(jax.grad(lambda zz, pr: pr.loss(zz)))(z, prob)
+        norms.append(float(np.linalg.norm(np.asarray(g["params"]))))
+        Ts.append(float(sub.ts[-1] - sub.ts[0]))
+    return np.asarray(Ts), np.asarray(norms)
