@@ -85,6 +85,12 @@ class MonitoredSolver(diffrax.AbstractWrappedSolver):
     def root_finder(self):
         return self.solver.root_finder  # pyright: ignore
 
+    @property
+    def scan_kind(self):
+        # diffrax.ForwardMode reads scan_kind of Runge-Kutta solvers (the wrapper passes its
+        # isinstance check); `simulate` has already set the inner one to "lax" in that case.
+        return getattr(self.solver, "scan_kind", "lax")
+
     def order(self, terms):
         return self.solver.order(terms)
 
@@ -343,6 +349,9 @@ def simulate(
     if dt0 is not None and not isinstance(dt0, jax.core.Tracer) and not (np.isfinite(dt0) and dt0 > 0):
         raise ValueError(f"'dt0' must be a positive finite step, got {dt0!r}")
     solver = _fill_implicit_tols(solver, rtol, atol)
+    if isinstance(adjoint, diffrax.ForwardMode) and getattr(solver, "scan_kind", "lax") is None:
+        # forward-mode JVPs cannot pass diffrax's default (checkpointed) inner scan
+        solver = eqx.tree_at(lambda s: s.scan_kind, solver, "lax", is_leaf=lambda x: x is None)
     if dtype == jnp.dtype(jnp.float32):
         params = jax.tree_util.tree_map(lambda x: jnp.asarray(x, jnp.float32), params)
     return _solve(
