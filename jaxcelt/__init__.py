@@ -10,15 +10,22 @@ from .contact import CONTACT_LAWS, AbstractContactLaw, Coulomb, CoulombSpin, Gen
 from .diagnostics import Diagnostics, centre_position, diagnostics, energy, tilt
 from .elliptic import contact_integrals, ellipke
 from .integral_law import CustomProfile, HertzProfile, IntegralLaw, UniformProfile, patch_integrals, profile_moments
+from .lyapunov import celt_lyapunov, largest_lyapunov
 from .model import STATE_NAMES, kinematics, normal_force, vector_field
 from .params import PARAM_NAMES, CeltParams
 from .solve import INVALID_KINDS, STATUS, Solution, simulate
 from .state import check_state, constraint_residual, initial_state
+from .sweep import SweepResult, bifurcation, continuation
 
 __version__ = "0.1.0"
 
 __all__ = [
     "AbstractContactLaw",
+    "SweepResult",
+    "bifurcation",
+    "celt_lyapunov",
+    "continuation",
+    "largest_lyapunov",
     "CONTACT_LAWS",
     "CeltParams",
     "Diagnostics",

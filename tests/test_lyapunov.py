@@ -66,7 +66,9 @@ def test_celt_projection_keeps_manifold(paper_params):
 @pytest.mark.slow
 def test_celt_vmapped_matches_single(paper_params):
     y0 = jc.initial_state(paper_params)
-    pb = jc.sweep.lanes_params(paper_params, "omega_pi", jnp.array([14.0, 17.0]))
+    from jaxcelt.sweep import lanes_params
+
+    pb = lanes_params(paper_params, "omega_pi", jnp.array([14.0, 17.0]))
     f = jax.jit(jax.vmap(lambda p, y: celt_lyapunov(p, y, periods=3)))
     rb = f(pb, jnp.stack([y0, y0]))
     r1 = jax.jit(lambda p, y: celt_lyapunov(p, y, periods=3))(paper_params.replace(omega_pi=17.0), y0)
