@@ -7,8 +7,10 @@ Importing jaxcelt enables float64 in JAX (``jax_enable_x64``).
 
 from . import _config  # noqa: F401  (float64 on)
 from .contact import CONTACT_LAWS, AbstractContactLaw, Coulomb, CoulombSpin, GeneralisedPade, Pade, get_contact_law
+from .data import MeasuredData, Trajectory, generate_data, load_data, save_data
 from .diagnostics import Diagnostics, centre_position, diagnostics, energy, tilt
 from .elliptic import contact_integrals, ellipke
+from .fit import FitResult, fit, project_state  # noqa: F811  (jaxcelt.fit is the function)
 from .integral_law import CustomProfile, HertzProfile, IntegralLaw, UniformProfile, patch_integrals, profile_moments
 from .lyapunov import celt_lyapunov, largest_lyapunov
 from .model import STATE_NAMES, kinematics, normal_force, vector_field
@@ -20,6 +22,14 @@ from .sweep import SweepResult, bifurcation, continuation
 __version__ = "0.1.0"
 
 __all__ = [
+    "FitResult",
+    "MeasuredData",
+    "Trajectory",
+    "fit",
+    "generate_data",
+    "load_data",
+    "project_state",
+    "save_data",
     "AbstractContactLaw",
     "SweepResult",
     "bifurcation",

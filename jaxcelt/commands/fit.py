@@ -1,0 +1,102 @@
+"""``jaxcelt fit data.npz ...``: identify contact parameters from a measured-data file.
+
+A thin layer over `jaxcelt.fit` and `jaxcelt.data.load_data`: parses options, shows a progress
+bar with the loss, prints the fitted values with 95% intervals, writes a JSON result and figures.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "fit",
+        help="fit contact parameters to a measured-data file (.npz or .nc)",
+        description="Fit parameters of the model to measured trajectories (file format: jaxcelt.data).",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+    )
+    p.add_argument("data", type=Path, help="data file written by jaxcelt.data.save_data (.npz or .nc)")
+    p.add_argument("--free", nargs="+", default=["mu", "k_r", "b_Ts", "m_Ts"], help="parameters to fit")
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="starting/fixed value of any CeltParams field (default: paper)",
+    )
+    p.add_argument(
+        "--kinds", nargs="+", default=None, help="use only these observation kinds (state omega orientation centre)"
+    )
+    p.add_argument("--optimiser", choices=("lm", "gn", "adam", "lbfgs"), default="lm")
+    p.add_argument("--windows", type=int, default=1, help="multiple-shooting windows per record (1 = single shooting)")
+    p.add_argument("--window-states", choices=("optimise", "data"), default="optimise")
+    p.add_argument("--fit-y0", action="store_true", help="also optimise the first initial state")
+    p.add_argument("--max-iter", type=int, default=100)
+    p.add_argument("--learning-rate", type=float, default=0.02, help="Adam step size")
+    p.add_argument("--out", type=Path, default=Path("out/fit"), help="output directory (fit.json, fit.png)")
+    p.add_argument("--no-plot", action="store_true")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from tqdm import tqdm
+
+    import jaxcelt as jc
+    from jaxcelt.commands.simulate import parse_overrides
+    from jaxcelt.data import load_data
+    from jaxcelt.fit import fit
+
+    try:
+        data = load_data(args.data)
+        if args.kinds:
+            data = data.subset(args.kinds)
+        params0 = jc.CeltParams.paper(**parse_overrides(args.set))
+    except (ValueError, OSError, KeyError) as e:
+        print(f"jaxcelt fit: {e}")
+        return 2
+    bar = tqdm(total=args.max_iter, disable=args.quiet, desc=f"fit ({args.optimiser})", unit="it")
+
+    def progress(it, loss, values):
+        bar.update(1)
+        bar.set_postfix(loss=f"{loss:.4g}", **{k: f"{v:.4g}" for k, v in values.items()})
+
+    try:
+        res = fit(
+            data,
+            params0,
+            free=tuple(args.free),
+            optimiser=args.optimiser,
+            windows=args.windows,
+            window_states=args.window_states,
+            fit_y0=args.fit_y0,
+            max_iter=args.max_iter,
+            learning_rate=args.learning_rate,
+            callback=progress,
+        )
+    except ValueError as e:
+        bar.close()
+        print(f"jaxcelt fit: {e}")
+        return 2
+    bar.close()
+    print(res.summary())
+    args.out.mkdir(parents=True, exist_ok=True)
+    from jaxcelt.versions import versions
+
+    (args.out / "fit.json").write_text(
+        json.dumps(res.to_dict() | {"data": str(args.data), "versions": versions()}, indent=1)
+    )
+    print(f"wrote {args.out / 'fit.json'}")
+    if not args.no_plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from jaxcelt.plotting.fit import plot_fit
+
+        true = data.meta.get("true_params")
+        plot_fit(res, true=true).savefig(args.out / "fit.png", dpi=110)
+        print(f"wrote {args.out / 'fit.png'}")
+    return 0
