@@ -17,16 +17,25 @@ Y_REG = np.array(
     [0.0490463814, 0.0435318374, 0.0042435563, 0.4, -0.3, 2.0, 0.0499152161, -0.0299491297,
      0.9983043228, 0.0216096967, 0.0065854161, 0.0212826865, 0.3]
 )  # fmt: skip
-# [N, v_sx, v_sy, omega_s, d_c, d_s, T_sx, T_sy, M_s, ydot(13)]
-REF = np.array(
-    [4.5547308092,
-     -95.32158376, 33.02544353, 2.02555947,
-     -0.2647549185, 0.4120477463,
-     -0.9454266651, 0.3268436384, 3.5416791537e-4,
-     1.7899098060, -0.6643126399, -1.5678459182, 21.575382072, 64.755124870, 7.5359886597,
-     0.23959303746, 0.29949129683, -2.9949129683e-3, 3.3676934057e-2, 5.6173725801e-2,
-     5.3807806856e-3, 2.0183851232]
-)  # fmt: skip
+# [N, v_sx, v_sy, omega_s, d_c, d_s, T_sx, T_sy, M_s, ydot(13)], exactly as printed in MODEL.md
+REF_TEXT = """4.5547308092
+-95.32158376 33.02544353 2.02555947
+-0.2647549185 0.4120477463
+-0.9454266651 0.3268436384 3.5416791537e-4
+1.7899098060 -0.6643126399 -1.5678459182 21.575382072 64.755124870 7.5359886597
+0.23959303746 0.29949129683 -2.9949129683e-3 3.3676934057e-2 5.6173725801e-2
+5.3807806856e-3 2.0183851232""".split()
+REF = np.array([float(x) for x in REF_TEXT])
+
+
+def _half_ulp(text):
+    """Half a unit in the last printed digit of a decimal string such as '-2.9949129683e-3'."""
+    mant, _, exp = text.lower().partition("e")
+    decimals = len(mant.partition(".")[2])
+    return 0.5 * 10.0 ** (-decimals + (int(exp) if exp else 0))
+
+
+PRINTED = np.array([_half_ulp(x) for x in REF_TEXT])
 NAMES = ["N", "v_sx", "v_sy", "omega_s", "d_c", "d_s", "T_sx", "T_sy", "M_s"] + [f"ydot[{i}]" for i in range(13)]
 
 
@@ -47,21 +56,25 @@ def test_regression_vector(paper_params):
     to y: v_s = v_A/a_hat amplifies by 1/a_hat = 161, and n_dot3 ~ -3e-3 is a difference of
     O(0.1) terms. So the admissible error of output i is
         1e-9 |ref_i| + sum_j |d out_i / d y_j| * 5e-11 + (half a unit in the last printed digit of ref_i),
-    the Jacobian from jax.jacfwd. The printed-digit term is below 1e-10 relative for every entry.
+    the Jacobian from jax.jacfwd. The printed-digit term matters for omega_s (9 digits printed:
+    2.5e-9 relative); the input-rounding term for M_s, n_dot3 (= ydot[8]), and v_dot3, omega_dot1
+    (measured errors 1.4e-9, 6.1e-9, 1.3e-9, 2.2e-9 relative; allowances 8.9e-9, 1.3e-8, 1.9e-9, 3.4e-9).
+    Every entry whose allowance is below 1e-9 relative must meet 1e-9 relative outright.
     """
     y = jnp.asarray(Y_REG)
     got = np.asarray(jax.jit(_quantities)(y, paper_params))
     J = np.asarray(jax.jit(jax.jacfwd(_quantities))(y, paper_params))
     assert np.all(np.isfinite(J))
     prop = np.abs(J).sum(axis=1) * 5e-11
-    printed = 5e-12 * np.abs(REF)  # >= 11 significant digits are printed for every entry
-    tol = 1e-9 * np.abs(REF) + prop + printed
+    tol = 1e-9 * np.abs(REF) + prop + PRINTED
     err = np.abs(got - REF)
     bad = [(NAMES[i], got[i], REF[i], err[i], tol[i]) for i in range(len(REF)) if err[i] > tol[i]]
     assert not bad, bad
-    # most entries must meet 1e-9 relative without the rounding allowance (guards against a loose bound)
+    # where rounding cannot explain 1e-9, the entry must meet 1e-9 relative outright
+    must = (prop + PRINTED) < 1e-9 * np.abs(REF)
     strict = err <= 1e-9 * np.abs(REF)
-    assert strict.sum() >= len(REF) - 4, [NAMES[i] for i in np.flatnonzero(~strict)]
+    assert must.sum() >= 10, [NAMES[i] for i in np.flatnonzero(must)]
+    assert np.all(strict[must]), [NAMES[i] for i in np.flatnonzero(must & ~strict)]
 
 
 def test_regression_vs_reference_numpy(paper_params):
