@@ -11,7 +11,7 @@ import importlib
 import sys
 
 # Each entry is a module in jaxcelt.commands exposing register(subparsers).
-COMMANDS: tuple[str, ...] = ("simulate", "bifurcation", "fit")
+COMMANDS: tuple[str, ...] = ("simulate", "bifurcation", "fit", "ladder")
 
 
 def build_parser() -> argparse.ArgumentParser:
