@@ -12,8 +12,10 @@ from .diagnostics import Diagnostics, centre_position, diagnostics, energy, tilt
 from .elliptic import contact_integrals, ellipke
 from .fit import FitResult, fit, project_state  # noqa: F811  (jaxcelt.fit is the function)
 from .integral_law import CustomProfile, HertzProfile, IntegralLaw, UniformProfile, patch_integrals, profile_moments
+from .ladder import Scene, hertz_params, run_ladder
 from .lyapunov import celt_lyapunov, largest_lyapunov
 from .model import STATE_NAMES, kinematics, normal_force, vector_field
+from .noslip import simulate_noslip
 from .params import PARAM_NAMES, CeltParams
 from .solve import INVALID_KINDS, STATUS, Solution, simulate
 from .state import check_state, constraint_residual, initial_state
@@ -48,6 +50,10 @@ __all__ = [
     "UniformProfile",
     "CustomProfile",
     "patch_integrals",
+    "Scene",
+    "hertz_params",
+    "run_ladder",
+    "simulate_noslip",
     "profile_moments",
     "INVALID_KINDS",
     "PARAM_NAMES",
