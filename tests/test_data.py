@@ -1,0 +1,107 @@
+"""Synthetic measured data and the data file format (jaxcelt.data)."""
+
+import dataclasses
+
+import jax
+import numpy as np
+import pytest
+
+import jaxcelt as jc
+from jaxcelt.data import OBSERVABLES, MeasuredData, generate_data, load_data, observe, save_data
+
+
+@pytest.fixture(scope="module")
+def setup():
+    p = jc.CeltParams.paper()
+    y0 = jc.initial_state(p, omega=(0.0, 0.0, 5.0), n=(np.sin(0.17), 0.0, np.cos(0.17)))
+    return p, y0
+
+
+@pytest.fixture(scope="module")
+def clean(setup):
+    p, y0 = setup
+    return generate_data(p, y0, 0.2, rate=50, kinds=tuple(OBSERVABLES))
+
+
+def test_observe_shapes_and_values(setup):
+    p, y0 = setup
+    for kind, k in OBSERVABLES.items():
+        assert observe(y0, p, kind).shape == (k,)
+    np.testing.assert_array_equal(observe(y0, p, "omega"), y0[3:6])
+    np.testing.assert_array_equal(observe(y0, p, "orientation"), np.r_[y0[6:9], y0[12]])
+    np.testing.assert_allclose(observe(y0, p, "centre"), jc.centre_position(y0, p))
+    with pytest.raises(ValueError, match="unknown observation kind"):
+        observe(y0, p, "gps")
+
+
+def test_clean_data_are_simulated_samples(setup, clean):
+    p, y0 = setup
+    tr = clean.trajectories[0]
+    # sampling: 0, 1/rate, ..., t1 inclusive
+    np.testing.assert_allclose(tr.ts, np.arange(11) / 50, atol=1e-14)
+    sol = jc.simulate(p, y0, float(tr.ts[-1]), ts=tr.ts, rtol=1e-10, atol=1e-12)
+    # same solver and tolerances: identical up to round-off
+    np.testing.assert_allclose(tr.obs["state"], np.asarray(sol.ys), rtol=0, atol=1e-12)
+    om = np.asarray(jax.vmap(lambda y: observe(y, p, "omega"))(sol.ys))
+    np.testing.assert_allclose(tr.obs["omega"], om, atol=1e-12)
+    # noise-free: sigma is the nominal 1% of the channel RMS
+    np.testing.assert_allclose(tr.sigma["omega"], 0.01 * np.sqrt(np.mean(om**2, axis=0)), rtol=1e-12)
+    np.testing.assert_array_equal(tr.y0, np.asarray(y0))
+    assert clean.meta["true_params"]["mu"] == pytest.approx(float(p.mu))
+
+
+def test_noise_level_and_reproducibility(setup, clean):
+    p, y0 = setup
+    a = generate_data(p, y0, 0.2, rate=50, kinds=tuple(OBSERVABLES), noise=0.05, seed=1)
+    b = generate_data(p, y0, 0.2, rate=50, kinds=tuple(OBSERVABLES), noise=0.05, seed=1)
+    c = generate_data(p, y0, 0.2, rate=50, kinds=tuple(OBSERVABLES), noise=0.05, seed=2)
+    np.testing.assert_array_equal(a.trajectories[0].obs["omega"], b.trajectories[0].obs["omega"])
+    assert not np.allclose(a.trajectories[0].obs["omega"], c.trajectories[0].obs["omega"])
+    # standardised noise over all 23 channels x 11 samples (253 draws): its std is 1 within
+    # ~3 standard errors (se ~ 1/sqrt(2*253) = 0.045) -> tolerance 0.15
+    z = np.concatenate(
+        [((a.trajectories[0].obs[k] - clean.trajectories[0].obs[k]) / a.trajectories[0].sigma[k]).ravel() for k in OBSERVABLES]
+    )
+    assert abs(np.std(z) - 1) < 0.15
+    assert abs(np.mean(z)) < 0.2
+
+
+@pytest.mark.parametrize("suffix", [".npz", ".nc"])
+def test_save_load_round_trip(tmp_path, clean, suffix):
+    d2 = MeasuredData((clean.trajectories[0], clean.trajectories[0].subset(["omega"])), clean.meta)
+    path = save_data(d2, tmp_path / f"d{suffix}")
+    back = load_data(path)
+    assert back.meta == d2.meta
+    assert len(back.trajectories) == 2
+    for t0, t1 in zip(d2.trajectories, back.trajectories):
+        assert t0.kinds == t1.kinds
+        np.testing.assert_array_equal(t0.ts, t1.ts)
+        for k in t0.kinds:
+            np.testing.assert_array_equal(t0.obs[k], t1.obs[k])
+            np.testing.assert_array_equal(t0.sigma[k], t1.sigma[k])
+        np.testing.assert_array_equal(t0.y0, t1.y0)
+        assert (t0.omega_pi, t0.q_pi) == (t1.omega_pi, t1.q_pi)
+
+
+def test_unknown_y0_and_bad_files(tmp_path, clean):
+    tr = dataclasses.replace(clean.trajectories[0], y0=None)
+    back = load_data(save_data(MeasuredData((tr,)), tmp_path / "a.npz"))
+    assert back.trajectories[0].y0 is None
+    np.savez(tmp_path / "b.npz", format=np.array("something else"))
+    with pytest.raises(ValueError, match="not a jaxcelt data file"):
+        load_data(tmp_path / "b.npz")
+    with pytest.raises(ValueError, match=".npz or .nc"):
+        save_data(clean, tmp_path / "c.pkl")
+
+
+def test_trajectory_validation(clean):
+    tr = clean.trajectories[0]
+    with pytest.raises(ValueError, match="increasing"):
+        dataclasses.replace(tr, ts=tr.ts[::-1])
+    with pytest.raises(ValueError, match="shape"):
+        dataclasses.replace(tr, obs={"omega": tr.obs["omega"][:, :2]}, sigma={"omega": tr.sigma["omega"]})
+    with pytest.raises(ValueError, match="sigma"):
+        dataclasses.replace(tr, obs={"omega": tr.obs["omega"]}, sigma={"omega": -tr.sigma["omega"]})
+    with pytest.raises(ValueError, match="not in the record"):
+        tr.subset(["omega"]).subset(["state"])
+    assert clean.subset(["centre"]).trajectories[0].kinds == ("centre",)
