@@ -1,0 +1,201 @@
+"""Does any reading of the paper reproduce its regimes at 14, 15.6, 17, 19 rad/s? (issue 5)
+
+The paper (section 3, Figs. 4-7) reports for q_pi = 0.04 m:
+  14 rad/s periodic, bounded;  15.6 periodic (locally), unbounded;  17 quasi-periodic, bounded;
+  19 chaotic, (seemingly) unbounded.
+Everything the text leaves open is swept in one vmapped batch of lanes (`jaxcelt.sweep.run_lanes`):
+the reading switches v_pi_sign and derivative_exact (MODEL.md section 9), the smoothing eps = eps_R,
+initial conditions (rest at several headings psi0, small roll/pitch rocking, slow spin) and the
+transient length; each lane is labelled with `jaxcelt.regimes.classify` (section period, largest
+Lyapunov exponent, global drift of O) twice: with the model's validity enforced (n3 <= 0 or
+lift-off -> "invalid") and with motion past n3 <= 0 allowed (labels ignore validity).
+
+Chunks are cached under --out (an interrupted run resumes). Writes docs/paper-reproduction/*.json
+and the table used by docs/paper-reproduction.md.
+
+    python scripts/paper_study.py --quick          # small smoke version
+    python scripts/paper_study.py                  # the study (tens of minutes on 2 CPU cores)
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+import jaxcelt as jc
+from jaxcelt.regimes import GLOBAL_MOTION, classify, regime_names
+from jaxcelt.sweep import SweepConfig, run_lanes
+from jaxcelt.versions import versions
+
+PAPER = {
+    14.0: ("periodic", "bounded"),
+    15.6: ("periodic", "unbounded"),
+    17.0: ("quasi-periodic", "bounded"),
+    19.0: ("chaotic", "unbounded"),
+}
+FREQS = tuple(PAPER)
+
+
+def initial_conditions(p: jc.CeltParams) -> dict[str, np.ndarray]:
+    """Named initial states (all on the contact manifold)."""
+    d = np.radians(2.0)
+    ics = {
+        "rest psi0=0": jc.initial_state(p),
+        "rest psi0=pi/4": jc.initial_state(p, psi=np.pi / 4),
+        "rest psi0=pi/2": jc.initial_state(p, psi=np.pi / 2),
+        "roll 2deg": jc.initial_state(p, n=(0.0, np.sin(d), np.cos(d))),
+        "pitch 2deg": jc.initial_state(p, n=(np.sin(d), 0.0, np.cos(d))),
+        "spin +1 rad/s": jc.initial_state(p, omega=(0.0, 0.0, 1.0)),
+    }
+    return {k: np.asarray(v) for k, v in ics.items()}
+
+
+def local_class(name: str) -> str:
+    return "periodic" if name.startswith("period-") else name
+
+
+def run(args) -> dict:
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    base = jc.CeltParams.paper()
+    ics = initial_conditions(base)
+    if args.quick:
+        ics = {k: ics[k] for k in ("rest psi0=0", "roll 2deg")}
+    eps_values = [float(e) for e in args.eps]
+    combos = list(itertools.product((1.0, -1.0), (0.0, 1.0), eps_values, list(ics)))
+    lanes = [(s, de, e, ic, w) for (s, de, e, ic) in combos for w in FREQS]
+    print(f"{len(lanes)} lanes = {len(combos)} combinations x {len(FREQS)} frequencies; {versions()}")
+    cfg = SweepConfig(
+        transient_periods=args.transient,
+        sample_periods=args.sample,
+        lyapunov_periods=args.lyapunov,
+        rtol=args.rtol,
+        atol=args.rtol * 1e-2,
+        max_steps=args.max_steps,
+    )
+    results: dict[str, list] = {}
+    chunk = args.chunk
+    t_start = time.perf_counter()
+    for c0 in range(0, len(lanes), chunk):
+        part = lanes[c0 : c0 + chunk]
+        cache = out / f"T{args.transient}_S{args.sample}_L{args.lyapunov}_rtol{args.rtol:g}_{c0:05d}_{len(part)}.npz"
+        if cache.exists():
+            r = dict(np.load(cache))
+        else:
+            fields = {k: np.asarray([getattr(base, k)] * len(part), dtype=float) for k in jc.PARAM_NAMES}
+            fields["v_pi_sign"] = np.array([x[0] for x in part])
+            fields["derivative_exact"] = np.array([x[1] for x in part])
+            fields["eps"] = np.array([x[2] for x in part])
+            fields["eps_R"] = np.array([x[2] for x in part])
+            fields["omega_pi"] = np.array([x[4] for x in part])
+            import jax
+
+            pb = jax.tree_util.tree_unflatten(jax.tree_util.tree_structure(base), [fields[k] for k in jc.PARAM_NAMES])
+            y0b = np.stack([ics[x[3]] for x in part])
+            t = time.perf_counter()
+            r = run_lanes(pb, y0b, cfg, pad_to=chunk)
+            r = {
+                k: r[k]
+                for k in (
+                    "samples",
+                    "status",
+                    "valid",
+                    "r_O",
+                    "lyapunov",
+                    "first_invalid_kind",
+                    "max_tilt",
+                    "min_N",
+                    "drift",
+                    "num_steps",
+                )
+            }
+            np.savez(cache, **r)
+            print(f"chunk {c0 // chunk + 1}/{-(-len(lanes) // chunk)}: {time.perf_counter() - t:.1f} s", flush=True)
+        for k, v in r.items():
+            results.setdefault(k, []).append(v)
+    R = {k: np.concatenate(v) for k, v in results.items()}
+    lab_strict = classify(R["samples"], R["status"], R["valid"], R["r_O"], R["lyapunov"])
+    lab_free = classify(R["samples"], R["status"], np.ones_like(R["valid"]), R["r_O"], R["lyapunov"])
+    names_strict = regime_names(lab_strict["regime"], lab_strict["period"])
+    names_free = regime_names(lab_free["regime"], lab_free["period"])
+    rows = []
+    for i, (s, de, e, ic, w) in enumerate(lanes):
+        rows.append(
+            dict(
+                v_pi_sign=s,
+                derivative_exact=de,
+                eps=e,
+                ic=ic,
+                omega_pi=w,
+                strict=str(names_strict[i]),
+                allowed=str(names_free[i]),
+                global_motion=GLOBAL_MOTION[int(lab_free["global_motion"][i])],
+                lyapunov=float(R["lyapunov"][i]),
+                drift_m=float(R["drift"][i]),
+                max_tilt_deg=float(np.degrees(R["max_tilt"][i])),
+                min_N=float(R["min_N"][i]),
+                status=int(R["status"][i]),
+                steps=int(R["num_steps"][i]),
+            )
+        )
+    # score each combination against the paper
+    table = []
+    for s, de, e, ic in combos:
+        sub = [r for r in rows if (r["v_pi_sign"], r["derivative_exact"], r["eps"], r["ic"]) == (s, de, e, ic)]
+        entry = dict(v_pi_sign=s, derivative_exact=de, eps=e, ic=ic, labels={}, score_strict=0, score_allowed=0)
+        for r in sub:
+            want_local, want_global = PAPER[r["omega_pi"]]
+            ok_global = r["global_motion"] == want_global
+            for mode in ("strict", "allowed"):
+                ok_local = local_class(r[mode]) == want_local
+                entry[f"score_{mode}"] += int(ok_local) + int(ok_global)
+            entry["labels"][str(r["omega_pi"])] = (
+                f"{r['allowed']}{'' if r['strict'] != 'invalid' else ' (invalid)'}, {r['global_motion']}, λ={r['lyapunov']:.3g}"
+            )
+        table.append(entry)
+    table.sort(key=lambda x: (-x["score_allowed"], -x["score_strict"]))
+    summary = dict(
+        config=dict(vars(args)),
+        versions=versions(),
+        wall_s=time.perf_counter() - t_start,
+        paper=PAPER,
+        rows=rows,
+        table=table,
+    )
+    tag = "quick" if args.quick else f"T{args.transient}_rtol{args.rtol:g}"
+    docs = Path(args.docs)
+    docs.mkdir(parents=True, exist_ok=True)
+    (docs / f"study_{tag}.json").write_text(json.dumps(summary, indent=1, default=str))
+    print(f"max score 8 (4 local + 4 global). Best combinations ({tag}):")
+    for t in table[:10]:
+        print(
+            t["score_allowed"], t["score_strict"], t["v_pi_sign"], t["derivative_exact"], t["eps"], t["ic"], t["labels"]
+        )
+    return summary
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--transient", type=int, default=300)
+    ap.add_argument("--sample", type=int, default=64)
+    ap.add_argument("--lyapunov", type=int, default=60)
+    ap.add_argument("--eps", nargs="+", default=["1e-2", "1e-4", "1e-6"])
+    ap.add_argument("--rtol", type=float, default=1e-8)
+    ap.add_argument("--max-steps", type=int, default=2_000_000)
+    ap.add_argument("--chunk", type=int, default=48)
+    ap.add_argument("--out", default="runs/paper_study")
+    ap.add_argument("--docs", default="docs/paper-reproduction")
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.transient, args.sample, args.lyapunov, args.eps, args.chunk = 20, 16, 8, ["1e-4"], 16
+    run(args)
+
+
+if __name__ == "__main__":
+    main()
