@@ -279,15 +279,19 @@ def run_lanes(
     cfg: SweepConfig,
     *,
     devices: Sequence[Any] | None = None,
+    pad_to: int | None = None,
 ) -> dict[str, np.ndarray]:
     """Run one chunk of lanes (batched params and y0 with a leading lane axis) and return numpy arrays.
 
-    Sharded over ``devices`` (default all local devices); padded to a multiple of their number.
+    Sharded over ``devices`` (default all local devices); padded with copies of the last lane
+    to ``pad_to`` lanes (so a short last chunk reuses the compiled shape) and to a multiple
+    of the device count. Padding lanes cost no extra loop iterations (they copy a lane of
+    the chunk) and are dropped.
     """
     mesh = _mesh(devices)
     L = int(np.shape(y0b)[0])
     ndev = 1 if mesh is None else mesh.devices.size
-    Lp = math.ceil(L / ndev) * ndev
+    Lp = math.ceil(max(L, pad_to or 0) / ndev) * ndev
     pb_np = jax.tree_util.tree_map(lambda x: _pad(np.asarray(x), Lp), pb)
     y0_np = _pad(np.asarray(y0b, dtype=np.float64), Lp)
     static_cfg = dataclasses.replace(cfg, transient_periods=0)  # transient is traced: no recompiles
@@ -417,7 +421,7 @@ def sweep(
             continue
         pb = jax.tree_util.tree_map(lambda x, idx=idx: np.asarray(x)[idx], pb_all)
         t_start = time.perf_counter()
-        res = run_lanes(pb, lane_y0[idx], cfg, devices=devices)
+        res = run_lanes(pb, lane_y0[idx], cfg, devices=devices, pad_to=cs)
         res["_seconds"] = np.full(len(idx), (time.perf_counter() - t_start) / len(idx))
         results[ci] = res
         if writer is not None:
