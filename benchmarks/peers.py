@@ -136,7 +136,7 @@ def single(scene, ys_ref, rtols, target, numpy_rhs: bool):
                 best[r["name"]] = r
     ref = best.get("jaxcelt Tsit5")
     table = []
-    for name, r in sorted(best.items(), key=lambda kv: kv[1]["run_s"]):
+    for _name, r in sorted(best.items(), key=lambda kv: kv[1]["run_s"]):
         table.append(dict(r, ratio_vs_jaxcelt=None if ref is None else r["run_s"] / ref["run_s"]))
     return rows, table
 
@@ -232,7 +232,7 @@ def main(argv=None):
     from jaxcelt.plotting.performance import plot_peers
 
     plot_peers(table, sc_rows).savefig(out / f"peers{tag}.png", dpi=110)
-    print("equal accuracy (error <= %.0e):" % args.target)
+    print(f"equal accuracy (error <= {args.target:.0e}):")
     for r in table:
         print(
             f"  {r['name']:28s} rtol {r['rtol']:.0e} err {r['error']:.1e} {r['run_s'] * 1e3:9.1f} ms  x{r['ratio_vs_jaxcelt'] or float('nan'):.2f}"

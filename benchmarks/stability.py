@@ -154,7 +154,7 @@ def part_d(quick: bool):
 
         for P in horizons:
 
-            def loss(mu, P=P):
+            def loss(mu, P=P, p0=p0, y0=y0, T=T):
                 p = p0.replace(mu=mu)
                 sol = jc.simulate(
                     p, y0, P * T, ts=jnp.array([P * T]), rtol=1e-8, atol=1e-10, exact_ts=True, max_steps=50_000
