@@ -350,3 +350,49 @@ def run_diffrax(
             scene, solver, rtol=rtol, atol=atol, dt0=dt0, law=law, dtype=dtype, max_steps=max_steps
         )
     return out
+
+
+# --------------------------------------------------------------------------------------------
+# reading results back (docs and notebook)
+
+
+def load_results(folder: str = "docs/performance", quick: bool = False) -> dict[str, Any]:
+    """The JSON files written by ``benchmarks/*.py`` (missing ones are left out)."""
+    import json
+    import pathlib
+
+    tag = "_quick" if quick else ""
+    out = {}
+    for name in ("reference", "work_precision", "stability", "peers"):
+        f = pathlib.Path(folder) / f"{name}{tag}.json"
+        if f.exists():
+            out[name] = json.loads(f.read_text())
+    return out
+
+
+def markdown_table(rows: list[dict], columns: list[str], fmt: dict[str, str] | None = None) -> str:
+    """A Markdown table of ``rows`` (dicts) restricted to ``columns``; floats via ``fmt``."""
+    fmt = fmt or {}
+
+    def cell(r, c):
+        v = r.get(c)
+        if v is None:
+            return ""
+        if isinstance(v, float):
+            return format(v, fmt.get(c, ".3g"))
+        return str(v)
+
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    lines += ["| " + " | ".join(cell(r, c) for c in columns) + " |" for r in rows]
+    return "\n".join(lines)
+
+
+def cheapest_at_accuracy(runs: list[dict], target: float) -> list[dict]:
+    """Per solver, the fastest run whose error is <= ``target`` (work-precision at equal accuracy)."""
+    best: dict[str, dict] = {}
+    for r in runs:
+        err = r.get("error")
+        if r.get("status", 0) == 0 and err is not None and np.isfinite(err) and err <= target:
+            if r["solver"] not in best or r["run_s"] < best[r["solver"]]["run_s"]:
+                best[r["solver"]] = r
+    return sorted(best.values(), key=lambda r: r["run_s"])

@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Reproduce the speed/accuracy study (issue 7): JSON + PNG under docs/performance/.
+#   benchmarks/run_all.sh            full size (hours on 2 CPU cores; minutes on a GPU box)
+#   benchmarks/run_all.sh --quick    minutes; writes *_quick.json / *_quick.png
+# Runs unchanged on CPU or GPU: JAX picks the device; every script prints versions + device.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+PY=${PYTHON:-.venv/bin/python}
+FLAG=${1:-}
+OUT=${OUT:-docs/performance}
+$PY benchmarks/reference.py $FLAG --out "$OUT"
+$PY benchmarks/work_precision.py $FLAG --out "$OUT"
+$PY benchmarks/stability.py $FLAG --out "$OUT"
+$PY benchmarks/peers.py $FLAG --out "$OUT"
+echo "done: results in $OUT"

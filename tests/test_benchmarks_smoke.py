@@ -1,0 +1,63 @@
+"""Smoke tests of the speed/accuracy benchmarks' quick path (issue 7) on a tiny scene.
+
+No timings are asserted (machines differ); only accuracy statements that hold on any machine.
+"""
+
+import pathlib
+import sys
+
+import numpy as np
+import pytest
+
+from jaxcelt import benchmarking as bm
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "benchmarks"))
+
+
+@pytest.fixture(scope="module")
+def tiny():
+    # fixed-table spin, 0.25 s: non-chaotic, sliding (not stiff), ~100 steps at 1e-12
+    return bm.make_scene("spin_reversal", 1)
+
+
+@pytest.fixture(scope="module")
+def ref(tiny):
+    import reference
+
+    return reference.reference(tiny, tol=1e-12)
+
+
+def test_reference_solvers_agree(ref):
+    # Two independent integrators (diffrax Dopri8; scipy DOP853 on the numba port, or on the JAX
+    # field if numba is missing) at tol 1e-12 over 0.25 s. Observed agreement ~1e-13; 1e-9 leaves
+    # a 1e4 margin for platform differences, while any disagreement in the right-hand side or a
+    # solver bug shows up at >= 1e-6.
+    assert ref["A"]["status"] == 0
+    assert ref["max_agreement"] < 1e-9, ref["max_agreement"]
+    assert ref["trusted_index"] == ref["periods"]
+
+
+def test_numba_port_matches_jax(tiny):
+    _peers = pytest.importorskip("_peers")
+    # same formulas, different summation order: agreement to a few ulps of the largest entry
+    assert _peers.check_against_jax(tiny.params, n_samples=5) < 1e-12
+
+
+def test_work_precision_quick_path(tiny, ref):
+    ys_ref = np.asarray(ref["A"]["ys"])
+    loose = bm.run_diffrax(tiny, "Tsit5", rtol=1e-5, ys_ref=ys_ref, repeats=1)
+    tight = bm.run_diffrax(tiny, "Tsit5", rtol=1e-9, ys_ref=ys_ref, repeats=1)
+    assert loose["status"] == 0 and tight["status"] == 0
+    # tolerance proportionality: 4 decades tighter must buy >= 2 decades of accuracy, and the
+    # global error at rtol 1e-9 over 0.25 s stays below 1e-6 (observed ~1e-9)
+    assert tight["error"] < 1e-2 * loose["error"]
+    assert tight["error"] < 1e-6
+    assert tight["compile_s"] >= 0 and tight["run_s"] > 0
+
+
+def test_fixed_step_wrapper_takes_constant_steps(tiny, ref):
+    dt = 2.5e-3
+    r = bm.run_diffrax(tiny, "RK4-fixed", dt0=dt, ys_ref=np.asarray(ref["A"]["ys"]), repeats=0)
+    assert r["rejected"] == 0
+    assert r["steps"] == round(tiny.t1 / dt)
+    assert r["error"] < 1e-3  # RK4 at 2.5 ms on a smooth sliding phase: observed ~1e-7
