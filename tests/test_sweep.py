@@ -116,7 +116,9 @@ def test_two_host_devices_equal_one():
         kw = dict(transient_periods=3, sample_periods=4, max_steps=4000, chunk_size=4)
         a = bifurcation(p, v, **kw)
         b = bifurcation(p, v, devices=jax.local_devices()[:1], **kw)
-        print("MAXDIFF", float(np.max(np.abs(a.samples - b.samples))), bool(np.array_equal(a.samples, b.samples)))
+        kw2 = dict(kw, chunk_size=2)  # same per-device batch (2 lanes) as the sharded run
+        c = bifurcation(p, v, devices=jax.local_devices()[:1], **kw2)
+        print("MAXDIFF", float(np.max(np.abs(a.samples - b.samples))), bool(np.array_equal(a.samples, c.samples)))
         """
     )
     env = dict(os.environ, XLA_FLAGS="--xla_force_host_platform_device_count=2")
@@ -124,4 +126,8 @@ def test_two_host_devices_equal_one():
     assert out.returncode == 0, out.stderr[-3000:]
     line = [s for s in out.stdout.splitlines() if s.startswith("MAXDIFF")][0]
     maxdiff = float(line.split()[1])
-    assert maxdiff <= 1e-12, line
+    # Against a 1-device chunk of 4 lanes the vector width differs (2 lanes per device), so
+    # XLA's roundoff differs and chaotic lanes amplify it over 7 periods: observed 2.4e-11;
+    # the issue's 1e-10 applies. With the same per-device batch the results are bitwise equal.
+    assert maxdiff <= 1e-10, line
+    assert line.split()[2] == "True", line
