@@ -1,6 +1,6 @@
 """Stability map (issue 7): where do methods fail?
 
-(a) stiffness from the friction smoothing: eps = eps_R from 1e-2 to 1e-10 on the from-rest scene;
+(a) stiffness from the friction smoothing: eps = eps_R from 1e-2 to 1e-10 on the stick-slip scene;
     explicit Tsit5 against implicit Kvaerno5 (diffrax's default chord root finder and full Newton);
     verdict per cell: ok / slow (> ``--slow`` steps per base period) / failed (max_steps, solver
     failure, non-finite) / wrong attractor (final state off the eps-specific reference by > 1e-2).
@@ -42,26 +42,29 @@ def _verdict(status, ys, ys_ref, steps, periods, slow_per_period, wrong_tol=1e-2
 
 
 def part_a(quick: bool, slow_per_period: float):
-    periods = 1 if quick else 2
-    epss = [1e-2, 1e-4, 1e-6] if quick else [1e-2, 1e-4, 1e-6, 1e-8, 1e-10]
+    # The stick-slip scene: from rest at q_pi = 0.04 m the stone slides all the time and eps does
+    # not matter (checked: identical step counts for eps 1e-2 ... 1e-6); stiffness appears only
+    # while sticking.
+    periods = 1
+    epss = [1e-4, 1e-6, 1e-8] if quick else [1e-2, 1e-4, 1e-6, 1e-8, 1e-10]
     methods = (
-        [("Tsit5", 1e-8), ("Kvaerno5-Newton", 1e-8)]
+        [("Tsit5", 1e-6), ("Kvaerno5", 1e-6), ("Kvaerno5-Newton", 1e-6)]
         if quick
         else [
             ("Tsit5", 1e-6),
             ("Tsit5", 1e-8),
-            ("Dopri8", 1e-10),
+            ("Dopri8", 1e-8),
             ("Kvaerno5", 1e-6),
             ("Kvaerno5-Newton", 1e-6),
             ("Kvaerno5-Newton", 1e-8),
         ]
     )
-    max_steps = 20_000 if quick else 100_000
+    max_steps = 50_000 if quick else 200_000
     rows = []
     for eps in epss:
-        sc = bm.make_scene("rest17", periods, eps=eps, eps_R=eps)
-        # eps-specific reference: implicit at 1e-11 (explicit references are infeasible at tiny eps)
-        rref = bm.run_diffrax(sc, "Kvaerno5-Newton", rtol=1e-11, atol=1e-13, repeats=0, max_steps=max_steps)
+        sc = bm.make_scene("stick_slip", periods, eps=eps, eps_R=eps)
+        # eps-specific reference: implicit at 1e-10 (explicit references are infeasible at tiny eps)
+        rref = bm.run_diffrax(sc, "Kvaerno5-Newton", rtol=1e-10, atol=1e-12, repeats=0, max_steps=max_steps)
         ys_ref = np.array([rref["final_state"]]) if rref["status"] == 0 else None
         for name, tol in methods:
             r = bm.run_diffrax(sc, name, rtol=tol, repeats=0, max_steps=max_steps)
@@ -82,13 +85,13 @@ def part_a(quick: bool, slow_per_period: float):
 
 def part_b(quick: bool):
     periods = 1 if quick else 2
-    dts = [5e-3, 1e-3, 2e-4, 5e-5] if quick else [1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4, 5e-5, 2e-5]
+    dts = [2e-3, 5e-4, 1e-4, 2e-5] if quick else [1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4, 5e-5, 2e-5]
     epss = [1e-4] if quick else [1e-4, 1e-6]
-    methods = ["RK4-fixed", "Heun-fixed"] if quick else ["RK4-fixed", "Heun-fixed", "Euler-fixed"]
+    methods = ["RK4-fixed"] if quick else ["RK4-fixed", "Heun-fixed", "Euler-fixed"]
     rows = []
     for eps in epss:
-        sc = bm.make_scene("rest17", periods, eps=eps, eps_R=eps)
-        ref = bm.run_diffrax(sc, "Kvaerno5-Newton", rtol=1e-11, atol=1e-13, repeats=0)
+        sc = bm.make_scene("stick_slip", periods, eps=eps, eps_R=eps)
+        ref = bm.run_diffrax(sc, "Kvaerno5-Newton", rtol=1e-10, atol=1e-12, repeats=0)
         ys_ref = np.array([ref["final_state"]])
         for name in methods:
             for dt in dts:
@@ -217,11 +220,11 @@ def main(argv=None):
     from jaxcelt.plotting.performance import plot_stability_map
 
     if "a" in res:
-        plot_stability_map(res["a"], "eps", "(a) friction-smoothing stiffness, rest17").savefig(
+        plot_stability_map(res["a"], "eps", "(a) friction-smoothing stiffness, stick-slip scene").savefig(
             out / f"stability_eps{tag}.png", dpi=110
         )
     if "b" in res:
-        plot_stability_map(res["b"], "dt", "(b) fixed-step blow-up, rest17").savefig(
+        plot_stability_map(res["b"], "dt", "(b) fixed-step blow-up, stick-slip scene").savefig(
             out / f"stability_dt{tag}.png", dpi=110
         )
     print("wrote", out / f"stability{tag}.json")

@@ -62,7 +62,7 @@ def ladder(scene, name, values, *, ys_ref, law=None, dtype=None, max_run_s=20.0,
             out.append(dict(scene=scene.name, solver=name, kind=kind, error_message=str(e)[:500], **kw))
             break
         if "rhs_evals" not in r:
-            r["rhs_evals"] = r["steps"] * _stages_per_step(name)
+            r["rhs_evals"] = None if kind == "implicit" else r["steps"] * _stages_per_step(name)
         out.append(r)
         print(
             f"  {name:16s} {r['dtype']:8s} {str(kw):22s} err {r['error']:.2e}  run {r['run_s'] * 1e3:8.1f} ms  "
@@ -91,19 +91,24 @@ def config(quick: bool):
             repeats=1,
         )
     return dict(
-        scenes=[("rest17", 5), ("rest19", 5), ("spin_reversal", 5), ("stick_slip", 1)],
-        rtols=[1e-4, 1e-6, 1e-8, 1e-10, 1e-12],
+        scenes=[("rest17", 5), ("stick_slip", 1), ("rest19", 5), ("spin_reversal", 5)],
+        rtols=[1e-4, 1e-6, 1e-8, 1e-10, 1e-12],  # a ladder stops early past max_run_s
         rtols_implicit=[1e-4, 1e-6, 1e-8, 1e-10],
         dts=[4e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4],
         explicit=EXPLICIT,
-        implicit=IMPLICIT,
+        implicit=["Kvaerno5", "Kvaerno3-Newton", "Kvaerno5-Newton"],
         fixed=FIXED,
         f32_rtols=[1e-2, 1e-3, 1e-4, 1e-5, 1e-6],
-        f32_solvers=["Tsit5", "Dopri5", "Kvaerno5-Newton"],
+        f32_solvers=["Tsit5", "Dopri5"],
         laws=[k for k in jc.CONTACT_LAWS],
         max_run_s=20.0,
         repeats=2,
     )
+
+
+def _save(res, out, quick):
+    # written after every part so that an interrupted long run keeps what it measured
+    (out / f"work_precision{'_quick' if quick else ''}.json").write_text(json.dumps(res, indent=1))
 
 
 def main(argv=None):
@@ -136,6 +141,7 @@ def main(argv=None):
             for s in cfg["fixed"]:
                 runs += ladder(sc, s, cfg["dts"], ys_ref=ref, max_run_s=cfg["max_run_s"], repeats=cfg["repeats"])
             res["scenes"].append(dict(scene=name, description=sc.description, periods=periods, runs=runs))
+            _save(res, out, args.quick)
     if "float32" in parts:
         sc = bm.make_scene("rest17", cfg["scenes"][0][1])
         ref = reference_ys(sc)
@@ -162,6 +168,7 @@ def main(argv=None):
             repeats=cfg["repeats"],
         )
         res["float32"] = runs
+        _save(res, out, args.quick)
     if "laws" in parts:
         sc = bm.make_scene("rest17", cfg["scenes"][0][1])
         for law in cfg["laws"]:
@@ -185,6 +192,7 @@ def main(argv=None):
                 repeats=cfg["repeats"],
             )
             res["laws"].append(dict(law=law, runs=runs))
+            _save(res, out, args.quick)
     res["total_seconds"] = time.perf_counter() - t_start
     tag = "_quick" if args.quick else ""
     path = out / f"work_precision{tag}.json"

@@ -111,8 +111,8 @@ def make_scene(name: str, periods: int = 5, **overrides) -> Scene:
         p = CeltParams.paper(**kw)
         y0 = initial_state(p)
         T = 2 * np.pi / float(p.omega_pi)
-        ts = T * np.arange(periods + 1)
-        desc = f"stick-slip, q_pi = {float(p.q_pi):g} m, eps = {float(p.eps):g}, {periods} periods"
+        ts = T * np.arange(5 * periods + 1) / 5  # 5 samples per period (same shape as 5 periods of rest*)
+        desc = f"stick-slip, q_pi = {float(p.q_pi):g} m, eps = {float(p.eps):g}, {periods} period(s), T/5 samples"
     else:
         raise ValueError(f"unknown scene {name!r}; known: {SCENES}")
     return Scene(name=name, params=p, y0=np.asarray(y0), t1=float(ts[-1]), ts=ts, description=desc)
@@ -252,6 +252,9 @@ class _Counter:
         self.n = 0
 
 
+_COUNTER = _Counter()
+
+
 class CountingLaw(AbstractContactLaw):
     """A contact law that counts its evaluations on the host (for RHS counts only, not timing).
 
@@ -283,7 +286,8 @@ def count_rhs_evals(scene: Scene, solver, *, rtol=1e-8, atol=1e-10, dt0=None, la
     Counts contact-law calls and subtracts the validity monitor's one per step (+1 at init).
     """
     inner = get_contact_law(law)
-    counter = _Counter()
+    counter = _COUNTER  # one static object: the counting solve compiles once per solver
+    counter.n = 0
     cl = CountingLaw(inner=inner, counter=counter, rolling_resistance=inner.rolling_resistance)
     sol = simulate(
         scene.params, scene.y0, scene.t1, ts=scene.ts, solver=solver, rtol=rtol, atol=atol, dt0=dt0,

@@ -52,7 +52,8 @@ def _wp_axes(fig_title, runs, groups_key="solver"):
         mk = _MARK.get(rr[0].get("kind"), "o")
         lab = nm if groups_key == "solver" else f"{nm}"
         a1.loglog([r["run_s"] for r in rr], err, mk + "-", color=cmap(i % 10), label=lab)
-        a2.loglog([r["rhs_evals"] for r in rr], err, mk + "-", color=cmap(i % 10), label=lab)
+        nfe = np.array([np.nan if r.get("rhs_evals") is None else r["rhs_evals"] for r in rr], float)
+        a2.loglog(nfe, err, mk + "-", color=cmap(i % 10), label=lab)
         bad = [r for r in rr if r["status"] != 0 or not np.isfinite(r["error"])]
         for r in bad:
             a1.plot(r["run_s"], 1e-16 if not np.isfinite(r["error"]) else r["error"], "x", color="r", ms=9)
