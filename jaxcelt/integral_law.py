@@ -68,7 +68,8 @@ class AbstractPressureProfile(eqx.Module):
 
     def norm(self) -> float:
         """2 pi int_0^1 raw(rho) rho d rho (1 for a normalised profile)."""
-        return float(2 * np.pi * _moment(self.raw, 1))
+        with jax.ensure_compile_time_eval():  # a constant, also while an outer jit traces
+            return float(2 * np.pi * _moment(self.raw, 1))
 
 
 def _moment(fn: Callable, i: int, n: int = 64) -> Array:
@@ -155,8 +156,13 @@ def patch_integrals(
     P2 = Px**2 + Py**2
     Pn = _safe_sqrt(P2)
     aw = jnp.abs(w)
-    den = jnp.maximum(jnp.maximum(w * w, Pn * aw), 1e-300)
-    cx, cy = Px * w / den, Py * w / den
+    den = jnp.maximum(w * w, Pn * aw)
+    # At v_s = 0 = omega_s the centre is arbitrary: take 0 with a double where, so that
+    # gradients stay finite there (den -> 0).
+    ok = den > 1e-150
+    den = jnp.where(ok, den, 1.0)
+    cx = jnp.where(ok, Px * w / den, 0.0)
+    cy = jnp.where(ok, Py * w / den, 0.0)
     c2 = jnp.minimum(cx**2 + cy**2, 1.0)
     # Angular breakpoints: tangent directions of c (phi_c +- pi/2) and the eta axis (+-pi/2).
     is0 = c2 == 0
