@@ -149,7 +149,7 @@ def _rhs(t, y, P, dy):
     Bm[2, 0], Bm[2, 1], Bm[2, 2] = -B13, -B23, B3
     rxn = np.empty(3)
     _cross(rho, n, rxn)
-    Bw = Bm @ w
+    Bw = np.array([_dot(Bm[0], w), _dot(Bm[1], w), _dot(Bm[2], w)])
     wxBw = np.empty(3)
     _cross(w, Bw, wxBw)
     sol = np.empty(3)

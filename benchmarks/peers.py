@@ -81,7 +81,8 @@ def _numba_ens(scene, rtol, lanes=1, Y0=None):
     ts = np.asarray(scene.ts, float)
     t0 = time.perf_counter()
     _peers.dopri5_ensemble(Y0, PP, ts, rtol, rtol * 1e-2, 1_000_000, out, stats)
-    return out, time.perf_counter() - t0, int(stats[:, 0].sum()) * 6, bool(np.all(stats[:, 2] == 0))
+    sec = time.perf_counter() - t0
+    return (out[0] if lanes == 1 else out), sec, int(stats[:, 0].sum()) * 6, bool(np.all(stats[:, 2] == 0))
 
 
 def single(scene, ys_ref, rtols, target, numpy_rhs: bool):
