@@ -192,7 +192,7 @@ class _Problem(eqx.Module):
         rec = self.records[i]
         s = rec.fixed_states
         if rec.free_windows:
-            s = s.at[jnp.array(rec.free_windows)].set(z["states"][i] * STATE_SCALE)
+            s = s.at[jnp.array(rec.free_windows)].set(z["states"][i] * STATE_SCALE[None, :])
         return s
 
     def simulate_windows(self, z, i: int) -> tuple[Array, Array]:
@@ -228,17 +228,17 @@ class _Problem(eqx.Module):
             pr = eqx.tree_at(lambda q: (q.omega_pi, q.q_pi), p, (rec.omega_pi, rec.q_pi))
             for kind in rec.obs:
                 h = jax.vmap(jax.vmap(lambda y, kind=kind, pr=pr: observe(y, pr, kind)))(ys)
-                r = (h - rec.obs[kind]) * rec.inv_sigma[kind] * jnp.sqrt(self.weights[kind])
+                r = (h - rec.obs[kind]) * rec.inv_sigma[kind][None, None, :] * jnp.sqrt(self.weights[kind])
                 # window k>0 starts at the previous window's last sample: count it once
                 mis.append(jnp.concatenate([r[0].reshape(-1), r[1:, 1:].reshape(-1)]))
             K = ys.shape[0]
             if K > 1:
                 starts = jax.vmap(lambda y, pr=pr: project_state(y, pr))(self.window_states(z, i))
-                c = (ys[:-1, -1] - starts[1:]) / STATE_SCALE
+                c = (ys[:-1, -1] - starts[1:]) / STATE_SCALE[None, :]
                 pen.append(c.reshape(-1) * jnp.sqrt(self.continuity_weight))
             if rec.free_windows:
-                raw = z["states"][i] * STATE_SCALE
-                g = (raw - jax.vmap(lambda y, pr=pr: project_state(y, pr))(raw)) / STATE_SCALE
+                raw = z["states"][i] * STATE_SCALE[None, :]
+                g = (raw - jax.vmap(lambda y, pr=pr: project_state(y, pr))(raw)) / STATE_SCALE[None, :]
                 pen.append(g.reshape(-1) * jnp.sqrt(self.continuity_weight))
         rm = jnp.concatenate(mis)
         rp = jnp.concatenate(pen) if pen else jnp.zeros(0)

@@ -58,6 +58,7 @@ def test_project_state_lands_on_manifold():
     jc.check_state(q, p)
 
 
+@pytest.mark.slow  # its own compilation of the forward-mode Jacobian (~30 s idle, ~2 min loaded)
 def test_jacobian_matches_finite_differences(short_imu):
     prob, z = F._build(short_imu.subset(["omega"]), PAPER, FREE, {}, {}, 1, "optimise", False, 1.0, "fwd", 1e-10, 1e-12, 100_000)
     zf = z["params"]
