@@ -60,7 +60,10 @@ def test_noise_level_and_reproducibility(setup, clean):
     # standardised noise over all 23 channels x 11 samples (253 draws): its std is 1 within
     # ~3 standard errors (se ~ 1/sqrt(2*253) = 0.045) -> tolerance 0.15
     z = np.concatenate(
-        [((a.trajectories[0].obs[k] - clean.trajectories[0].obs[k]) / a.trajectories[0].sigma[k]).ravel() for k in OBSERVABLES]
+        [
+            ((a.trajectories[0].obs[k] - clean.trajectories[0].obs[k]) / a.trajectories[0].sigma[k]).ravel()
+            for k in OBSERVABLES
+        ]
     )
     assert abs(np.std(z) - 1) < 0.15
     assert abs(np.mean(z)) < 0.2

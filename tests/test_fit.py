@@ -60,7 +60,9 @@ def test_project_state_lands_on_manifold():
 
 @pytest.mark.slow  # its own compilation of the forward-mode Jacobian (~30 s idle, ~2 min loaded)
 def test_jacobian_matches_finite_differences(short_imu):
-    prob, z = F._build(short_imu.subset(["omega"]), PAPER, FREE, {}, {}, 1, "optimise", False, 1.0, "fwd", 1e-10, 1e-12, 100_000)
+    prob, z = F._build(
+        short_imu.subset(["omega"]), PAPER, FREE, {}, {}, 1, "optimise", False, 1.0, "fwd", 1e-10, 1e-12, 100_000
+    )
     zf = z["params"]
     r, J = F._value_and_jacobian(prob, zf)
     h = 1e-6
@@ -135,6 +137,8 @@ def test_other_optimisers_reduce_loss(short_imu, optimiser):
 @pytest.mark.slow
 def test_multiple_shooting_optimised_states(short_imu):
     # IMU only: window states start from a simulation at the paper's values and are optimised
-    res = jc.fit(short_imu.subset(["omega"]), PAPER, free=FREE, optimiser="lm", windows=2, window_states="optimise", max_iter=60)
+    res = jc.fit(
+        short_imu.subset(["omega"]), PAPER, free=FREE, optimiser="lm", windows=2, window_states="optimise", max_iter=60
+    )
     assert max(res.relative_error(TRUE).values()) < 0.01
     assert res.continuity < 1e-8

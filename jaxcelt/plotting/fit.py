@@ -105,7 +105,15 @@ def plot_correlation(results, labels: Sequence[str]):
         a.set_yticks(range(len(r.free)), r.free)
         for i in range(c.shape[0]):
             for j in range(c.shape[1]):
-                a.text(j, i, f"{c[i, j]:.2f}", ha="center", va="center", fontsize=8, color="w" if abs(c[i, j]) > 0.6 else "k")
+                a.text(
+                    j,
+                    i,
+                    f"{c[i, j]:.2f}",
+                    ha="center",
+                    va="center",
+                    fontsize=8,
+                    color="w" if abs(c[i, j]) > 0.6 else "k",
+                )
         a.set_title(lab)
     fig.colorbar(im, ax=ax, shrink=0.8, label="correlation")
     return fig
