@@ -32,7 +32,12 @@ from .state import check_state
 
 __all__ = ["simulate", "Solution", "MonitoredSolver", "Validity", "INVALID_KINDS", "STATUS", "DEFAULT_SOLVER"]
 
-INVALID_KINDS = {0: "valid", 1: "lift-off (N <= 0)", 2: "contact off the lower half-surface (n3 <= 0)", 3: "constraint denominator <= 0"}
+INVALID_KINDS = {
+    0: "valid",
+    1: "lift-off (N <= 0)",
+    2: "contact off the lower half-surface (n3 <= 0)",
+    3: "constraint denominator <= 0",
+}
 STATUS = {0: "success", 1: "max_steps reached", 2: "stopped at invalid state", 3: "solver failure"}
 
 
@@ -184,7 +189,7 @@ def _fill_implicit_tols(solver, rtol, atol):
         rf = solver.root_finder
         for attr, val in (("rtol", rtol), ("atol", atol), ("norm", optx.rms_norm)):
             if getattr(rf, attr, None) is use_stepsize_tol:
-                rf = eqx.tree_at(lambda r: getattr(r, attr), rf, val)
+                rf = eqx.tree_at(lambda r, attr=attr: getattr(r, attr), rf, val)
         solver = eqx.tree_at(lambda s: s.root_finder, solver, rf)
     return solver
 
@@ -257,10 +262,12 @@ def _solve(
     )
 
 
-def _as_float(x, dtype, name):
+def _as_float(x, dtype, name, scalar=False):
     if x is None:
         return None
     a = jnp.asarray(x, dtype=dtype)
+    if scalar and a.ndim != 0:
+        raise ValueError(f"{name!r} must be a scalar, got shape {a.shape} (vmap simulate for batches)")
     if not isinstance(a, jax.core.Tracer) and not np.all(np.isfinite(np.asarray(a))):
         raise ValueError(f"{name!r} must be finite, got {np.asarray(a)}")
     return a
@@ -322,6 +329,8 @@ def simulate(
     if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1:
         raise ValueError(f"max_steps must be a positive int, got {max_steps!r}")
     for name, tol in (("rtol", rtol), ("atol", atol)):
+        if np.ndim(tol) != 0:
+            raise ValueError(f"{name!r} must be a scalar, got shape {np.shape(tol)}")
         if not isinstance(tol, jax.core.Tracer) and not (np.isfinite(tol) and tol > 0):
             raise ValueError(f"{name!r} must be a positive finite number, got {tol!r}")
     law = get_contact_law(contact_law)
@@ -329,8 +338,8 @@ def simulate(
     y0a = _as_float(y0, dtype, "y0")
     if y0a.shape != (13,):
         raise ValueError(f"'y0' must have shape (13,), got {y0a.shape} (vmap simulate for batches)")
-    t0a = _as_float(t0, dtype, "t0")
-    t1a = _as_float(t1, dtype, "t1")
+    t0a = _as_float(t0, dtype, "t0", scalar=True)
+    t1a = _as_float(t1, dtype, "t1", scalar=True)
     if not isinstance(t1a, jax.core.Tracer) and not isinstance(t0a, jax.core.Tracer) and not float(t1a) > float(t0a):
         raise ValueError(f"'t1' must be greater than 't0' (got t0={float(t0a)}, t1={float(t1a)})")
     tsa = _as_float(ts, dtype, "ts")
