@@ -218,7 +218,7 @@ def numba_rhs(p):
 
     def f(t, y):
         dy = np.empty(13)
-        rhs_nb(t, np.asarray(y, dtype=np.float64), P, dy)
+        rhs_nb(float(t), np.ascontiguousarray(y, dtype=np.float64), P, dy)
         return dy
 
     return f
