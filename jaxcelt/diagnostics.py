@@ -84,7 +84,9 @@ def _many(ts, ys, params, law):
     return jax.vmap(_one, in_axes=(0, 0, None, None))(ts, ys, params, law)
 
 
-def diagnostics(ts: Array, ys: Array, params: CeltParams, contact_law: AbstractContactLaw | str | None = None) -> Diagnostics:
+def diagnostics(
+    ts: Array, ys: Array, params: CeltParams, contact_law: AbstractContactLaw | str | None = None
+) -> Diagnostics:
     """Observables at saved states ``ys`` (n, 13) and times ``ts`` (n,). Non-finite rows give NaN."""
     ts = jnp.asarray(ts, dtype=float)
     ys = jnp.asarray(ys, dtype=float)

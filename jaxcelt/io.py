@@ -12,7 +12,9 @@ from .params import CeltParams
 from .versions import versions
 
 
-def save_trajectory(path: str | Path, ts, ys, params: CeltParams, *, extra: dict | None = None, meta: dict | None = None) -> Path:
+def save_trajectory(
+    path: str | Path, ts, ys, params: CeltParams, *, extra: dict | None = None, meta: dict | None = None
+) -> Path:
     """Save times ``ts`` (n,), states ``ys`` (n, 13) and optional extra arrays to ``path`` (.npz).
 
     Metadata (parameters, state names, versions, anything in ``meta``) is stored as a JSON

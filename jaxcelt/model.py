@@ -20,7 +20,7 @@ from typing import NamedTuple
 
 import jax.numpy as jnp
 
-from ._types import Array, Scalar, ScalarLike, State, Vec3
+from ._types import Scalar, ScalarLike, State, Vec3
 from .contact import AbstractContactLaw, ContactKinematics, ContactLoads, get_contact_law
 from .params import CeltParams
 
@@ -191,7 +191,9 @@ def normal_force_parts(kin: Kinematics, loads: ContactLoads, p: CeltParams) -> t
     return num, den
 
 
-def normal_force(t: ScalarLike, y: State, params: CeltParams, contact_law: AbstractContactLaw | str | None = None) -> Scalar:
+def normal_force(
+    t: ScalarLike, y: State, params: CeltParams, contact_law: AbstractContactLaw | str | None = None
+) -> Scalar:
     """Normal reaction N [N] at state y and time t (MODEL.md section 8)."""
     law = get_contact_law(contact_law)
     kin = kinematics(t, y, params)
@@ -199,7 +201,9 @@ def normal_force(t: ScalarLike, y: State, params: CeltParams, contact_law: Abstr
     return num / den
 
 
-def vector_field(t: ScalarLike, y: State, params: CeltParams, contact_law: AbstractContactLaw | str | None = None) -> State:
+def vector_field(
+    t: ScalarLike, y: State, params: CeltParams, contact_law: AbstractContactLaw | str | None = None
+) -> State:
     """dy/dt of the wobblestone (eqs. 1, 5, 6 with N from the constraint), shape (13,).
 
     m (v_dot + w x v) = -m g n + N (n + t)

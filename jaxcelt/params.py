@@ -202,9 +202,7 @@ def _validate(p: CeltParams) -> None:
     B = np.asarray(inertia_tensor(jax.tree_util.tree_map(np.asarray, p)))
     eig = np.linalg.eigvalsh(B)
     if np.any(eig <= 0):
-        raise ValueError(
-            f"inertia tensor 'B' (B1, B2, B3, B12, B13, B23) must be positive definite; eigenvalues {eig}"
-        )
+        raise ValueError(f"inertia tensor 'B' (B1, B2, B3, B12, B13, B23) must be positive definite; eigenvalues {eig}")
     # Principal moments of a real body satisfy the triangle inequality I_i <= I_j + I_k.
     s = eig.sum(-1, keepdims=True)
     if np.any(2 * eig > s * (1 + 1e-12)):

@@ -46,7 +46,13 @@ def initial_state(
     v_A = jnp.asarray(v_A, dtype=float)
     psi = jnp.asarray(psi, dtype=float)
     position = jnp.asarray(position, dtype=float)
-    for name, x, shape in (("omega", omega, (3,)), ("n", n, (3,)), ("v_A", v_A, (3,)), ("psi", psi, ()), ("position", position, (2,))):
+    for name, x, shape in (
+        ("omega", omega, (3,)),
+        ("n", n, (3,)),
+        ("v_A", v_A, (3,)),
+        ("psi", psi, ()),
+        ("position", position, (2,)),
+    ):
         if x.shape != shape:
             raise ValueError(f"initial_state: {name!r} must have shape {shape}, got {x.shape}")
         if not isinstance(x, jax.core.Tracer) and not np.all(np.isfinite(np.asarray(x))):
@@ -58,13 +64,19 @@ def initial_state(
                 raise ValueError("initial_state: 'n' must be non-zero")
             n = n / nn
         elif abs(nn - 1) > MANIFOLD_TOL:
-            raise ValueError(f"initial_state: 'n' must be a unit vector (|n| = {nn:.12g}); pass normalize=True to rescale")
+            raise ValueError(
+                f"initial_state: 'n' must be a unit vector (|n| = {nn:.12g}); pass normalize=True to rescale"
+            )
         if float(n[2]) <= 0:
-            raise ValueError(f"initial_state: 'n' must have n3 > 0 (contact on the lower half-surface), got n = {np.asarray(n)}")
+            raise ValueError(
+                f"initial_state: 'n' must have n3 > 0 (contact on the lower half-surface), got n = {np.asarray(n)}"
+            )
         if abs(float(n[1])) >= 1 - 1e-12:
             raise ValueError("initial_state: n2 = +-1 (body x2 vertical) is the singular point of psi (eq. 6)")
         if not isinstance(v_A, jax.core.Tracer) and abs(float(jnp.dot(v_A, n))) > MANIFOLD_TOL:
-            raise ValueError(f"initial_state: 'v_A' must be tangent to the base (v_A . n = {float(jnp.dot(v_A, n)):.3g} m/s)")
+            raise ValueError(
+                f"initial_state: 'v_A' must be tangent to the base (v_A . n = {float(jnp.dot(v_A, n)):.3g} m/s)"
+            )
     else:
         n = n / jnp.linalg.norm(n)
     v_A = v_A - jnp.dot(v_A, n) * n
@@ -103,7 +115,11 @@ def check_state(y: ArrayLike, params: CeltParams, *, name: str = "y0", tol: floa
         return
     pb = params if np.ndim(params.m) == 0 else None
     for i, yi in enumerate(flat):
-        p = pb if pb is not None else jax.tree_util.tree_map(lambda x: x.reshape(-1)[i] if np.size(x) == len(flat) else x, params)
+        p = (
+            pb
+            if pb is not None
+            else jax.tree_util.tree_map(lambda x, i=i: x.reshape(-1)[i] if np.size(x) == len(flat) else x, params)
+        )
         dn, c, h = (float(v) for v in constraint_residual(jnp.asarray(yi), p))
         where = f"{name}[{i}]" if len(flat) > 1 else name
         if abs(dn) > tol:
@@ -113,4 +129,6 @@ def check_state(y: ArrayLike, params: CeltParams, *, name: str = "y0", tol: floa
         if abs(c) > tol:
             raise ValueError(f"{where!r}: off the contact manifold, v_A . n = {c:.3g} m/s (use jaxcelt.initial_state)")
         if abs(h) > tol:
-            raise ValueError(f"{where!r}: r_C3 inconsistent with the contact (off by {h:.3g} m; use jaxcelt.initial_state)")
+            raise ValueError(
+                f"{where!r}: r_C3 inconsistent with the contact (off by {h:.3g} m; use jaxcelt.initial_state)"
+            )

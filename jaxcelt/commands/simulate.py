@@ -29,10 +29,14 @@ def register(sub) -> None:
     p.add_argument("--q-pi", type=float, default=0.04, help="base amplitude q_pi [m]")
     p.add_argument("--periods", type=float, default=20.0, help="duration in forcing periods 2 pi/omega_pi")
     p.add_argument("--samples-per-period", type=int, default=50, help="saved states per period")
-    p.add_argument("--omega0", type=_floats(3), default=[0.0, 0.0, 0.0], help="initial omega (body) [rad/s], 'w1,w2,w3'")
+    p.add_argument(
+        "--omega0", type=_floats(3), default=[0.0, 0.0, 0.0], help="initial omega (body) [rad/s], 'w1,w2,w3'"
+    )
     p.add_argument("--n0", type=_floats(3), default=[0.0, 0.0, 1.0], help="initial vertical in body axes (normalised)")
     p.add_argument("--psi0", type=float, default=0.0, help="initial heading psi [rad]")
-    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="override any CeltParams field, repeatable")
+    p.add_argument(
+        "--set", action="append", default=[], metavar="NAME=VALUE", help="override any CeltParams field, repeatable"
+    )
     p.add_argument("--rtol", type=float, default=1e-8)
     p.add_argument("--atol", type=float, default=1e-10)
     p.add_argument("--stop-on-invalid", action="store_true", help="stop at lift-off or n3 <= 0")
@@ -70,7 +74,9 @@ def run(args) -> int:
     t1 = args.periods * T
     ts = np.linspace(0.0, t1, int(round(args.periods * args.samples_per_period)) + 1)
     t = time.perf_counter()
-    sol = jc.simulate(params, y0, t1, ts=ts, rtol=args.rtol, atol=args.atol, stop_on_invalid=args.stop_on_invalid, progress=True)
+    sol = jc.simulate(
+        params, y0, t1, ts=ts, rtol=args.rtol, atol=args.atol, stop_on_invalid=args.stop_on_invalid, progress=True
+    )
     sol.ys.block_until_ready()
     wall = time.perf_counter() - t
     print(sol.summary())
@@ -88,7 +94,9 @@ def run(args) -> int:
         "first_invalid_t": float(sol.validity.first_invalid_t),
         "first_invalid_kind": jc.INVALID_KINDS[int(sol.validity.first_invalid_kind)],
     }
-    path = save_trajectory(args.out / f"{stem}.npz", sol.ts, sol.ys, params, meta=meta, extra={"N": diag.N, "r_O": diag.r_O})
+    path = save_trajectory(
+        args.out / f"{stem}.npz", sol.ts, sol.ys, params, meta=meta, extra={"N": diag.N, "r_O": diag.r_O}
+    )
     (args.out / f"{stem}.json").write_text(json.dumps(meta, indent=2))
     print(f"wrote {path}")
     if not args.no_plot:
