@@ -107,7 +107,7 @@ def plot_stability_map(rows: list[dict], x_key: str = "eps", title: str = "Stabi
     """Coloured grid: rows = method (+tolerance), columns = ``x_key`` values; cell text = steps."""
     methods = list(dict.fromkeys(r["method"] for r in rows))
     xs = sorted({r[x_key] for r in rows}, reverse=True)
-    fig, ax = plt.subplots(figsize=(1.15 * len(xs) + 3, 0.45 * len(methods) + 1.6))
+    fig, ax = plt.subplots(figsize=(max(8.0, 1.15 * len(xs) + 3.5), 0.45 * len(methods) + 2.0))
     for i, m in enumerate(methods):
         for j, x in enumerate(xs):
             rr = [r for r in rows if r["method"] == m and r[x_key] == x]
@@ -131,7 +131,7 @@ def plot_stability_map(rows: list[dict], x_key: str = "eps", title: str = "Stabi
         loc="upper center",
         bbox_to_anchor=(0.5, -0.12 - 0.2 / max(len(methods), 1)),
     )
-    ax.set_title(title + " (cell text: steps)", fontsize=10)
+    ax.set_title(title + "\n(cell text: steps, accepted + rejected)", fontsize=10)
     fig.tight_layout()
     return fig
 
