@@ -20,6 +20,7 @@ and the table used by docs/paper-reproduction.md.
 from __future__ import annotations
 
 import argparse
+import hashlib
 import itertools
 import json
 import time
@@ -52,6 +53,10 @@ def initial_conditions(p: jc.CeltParams) -> dict[str, np.ndarray]:
         "pitch 2deg": jc.initial_state(p, n=(np.sin(d), 0.0, np.cos(d))),
         "spin +1 rad/s": jc.initial_state(p, omega=(0.0, 0.0, 1.0)),
     }
+    # headings: psi0 sweeps the angle between the long axis and the vibration; psi0 + pi with
+    # v_pi_sign = +1 is the same motion as psi0 with v_pi_sign = -1 (tests/test_symmetry.py)
+    for k in range(16):
+        ics[f"rest psi0={22.5 * k:g}deg"] = jc.initial_state(p, psi=np.radians(22.5 * k))
     return {k: np.asarray(v) for k, v in ics.items()}
 
 
@@ -64,10 +69,17 @@ def run(args) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     base = jc.CeltParams.paper()
     ics = initial_conditions(base)
+    if args.ics:
+        unknown = set(args.ics) - set(ics)
+        if unknown:
+            raise SystemExit(f"unknown initial conditions {sorted(unknown)}; known: {sorted(ics)}")
+        ics = {k: ics[k] for k in args.ics}
     if args.quick:
         ics = {k: ics[k] for k in ("rest psi0=0", "roll 2deg")}
     eps_values = [float(e) for e in args.eps]
-    combos = list(itertools.product((1.0, -1.0), (0.0, 1.0), eps_values, list(ics)))
+    signs = [float(x) for x in args.signs]
+    des = [float(x) for x in args.derivative_exact]
+    combos = list(itertools.product(signs, des, eps_values, list(ics)))
     lanes = [(s, de, e, ic, w) for (s, de, e, ic) in combos for w in FREQS]
     print(f"{len(lanes)} lanes = {len(combos)} combinations x {len(FREQS)} frequencies; {versions()}")
     cfg = SweepConfig(
@@ -83,7 +95,8 @@ def run(args) -> dict:
     t_start = time.perf_counter()
     for c0 in range(0, len(lanes), chunk):
         part = lanes[c0 : c0 + chunk]
-        cache = out / f"T{args.transient}_S{args.sample}_L{args.lyapunov}_rtol{args.rtol:g}_{c0:05d}_{len(part)}.npz"
+        key = hashlib.sha1(repr(part).encode()).hexdigest()[:12]
+        cache = out / f"T{args.transient}_S{args.sample}_L{args.lyapunov}_rtol{args.rtol:g}_{key}.npz"
         if cache.exists():
             r = dict(np.load(cache))
         else:
@@ -119,8 +132,14 @@ def run(args) -> dict:
         for k, v in r.items():
             results.setdefault(k, []).append(v)
     R = {k: np.concatenate(v) for k, v in results.items()}
-    lab_strict = classify(R["samples"], R["status"], R["valid"], R["r_O"], R["lyapunov"])
-    lab_free = classify(R["samples"], R["status"], np.ones_like(R["valid"]), R["r_O"], R["lyapunov"])
+    # A finite-time exponent of a quasi-periodic orbit decays like 1/t: call a lane chaotic only
+    # when lambda exceeds 2 / (Lyapunov horizon) (and the classifier's 0.02 1/s floor).
+    t_lyap = args.lyapunov * 2 * np.pi / np.array([x[4] for x in lanes])
+    thr = float(np.max(np.maximum(0.02, 2.0 / np.maximum(t_lyap, 1e-9))))
+    lab_strict = classify(R["samples"], R["status"], R["valid"], R["r_O"], R["lyapunov"], chaos_threshold=thr)
+    lab_free = classify(
+        R["samples"], R["status"], np.ones_like(R["valid"]), R["r_O"], R["lyapunov"], chaos_threshold=thr
+    )
     names_strict = regime_names(lab_strict["regime"], lab_strict["period"])
     names_free = regime_names(lab_free["regime"], lab_free["period"])
     rows = []
@@ -138,6 +157,7 @@ def run(args) -> dict:
                 lyapunov=float(R["lyapunov"][i]),
                 drift_m=float(R["drift"][i]),
                 max_tilt_deg=float(np.degrees(R["max_tilt"][i])),
+                first_invalid_t=float(R["first_invalid_t"][i]) if "first_invalid_t" in R else None,
                 min_N=float(R["min_N"][i]),
                 status=int(R["status"][i]),
                 steps=int(R["num_steps"][i]),
@@ -163,11 +183,12 @@ def run(args) -> dict:
         config=dict(vars(args)),
         versions=versions(),
         wall_s=time.perf_counter() - t_start,
+        chaos_threshold=thr,
         paper=PAPER,
         rows=rows,
         table=table,
     )
-    tag = "quick" if args.quick else f"T{args.transient}_rtol{args.rtol:g}"
+    tag = args.tag or ("quick" if args.quick else f"T{args.transient}_rtol{args.rtol:g}")
     docs = Path(args.docs)
     docs.mkdir(parents=True, exist_ok=True)
     (docs / f"study_{tag}.json").write_text(json.dumps(summary, indent=1, default=str))
@@ -186,6 +207,10 @@ def main(argv=None):
     ap.add_argument("--sample", type=int, default=64)
     ap.add_argument("--lyapunov", type=int, default=60)
     ap.add_argument("--eps", nargs="+", default=["1e-2", "1e-4", "1e-6"])
+    ap.add_argument("--ics", nargs="+", default=None, help="subset of initial conditions (names)")
+    ap.add_argument("--signs", nargs="+", default=["1", "-1"], help="v_pi_sign values")
+    ap.add_argument("--derivative-exact", nargs="+", default=["0", "1"], help="derivative_exact values")
+    ap.add_argument("--tag", default=None, help="name of the output JSON (default from settings)")
     ap.add_argument("--rtol", type=float, default=1e-8)
     ap.add_argument("--max-steps", type=int, default=2_000_000)
     ap.add_argument("--chunk", type=int, default=48)
