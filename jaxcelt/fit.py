@@ -15,7 +15,8 @@ Residuals r(z) (all dimensionless, stacked into one vector):
   13-vector that the projection removes.
 
 loss = 1/2 |r|^2. Optimisers: ``"lm"`` (optimistix Levenberg-Marquardt, forward-mode Jacobians via
-``diffrax.ForwardMode``), ``"gn"`` (optimistix Gauss-Newton), ``"adam"`` and ``"lbfgs"`` (optax,
+``diffrax.ForwardMode``), ``"gn"`` (optimistix Gauss-Newton), ``"gn-damped"`` (Gauss-Newton with a
+backtracking Armijo line search), ``"adam"`` and ``"lbfgs"`` (optax,
 reverse-mode gradients). Uncertainty (`FitResult.stderr`, ``ci95``, ``corr``): the Gauss-Newton
 approximation cov(z) = s^2 (J^T J)^-1 at the optimum with s^2 = RSS_misfit / (n_data - n_unknowns),
 marginalised over the window states, mapped to the physical parameters by the delta method.
@@ -57,13 +58,14 @@ __all__ = [
     "DEFAULT_TRANSFORMS",
     "STATE_SCALE",
     "OPTIMISERS",
+    "DampedGaussNewton",
     "project_state",
     "predict",
     "finite_time_lyapunov",
     "gradient_norm_vs_window",
 ]
 
-OPTIMISERS = ("lm", "gn", "adam", "lbfgs")
+OPTIMISERS = ("lm", "gn", "gn-damped", "adam", "lbfgs")
 
 STATE_SCALE = np.array([0.1, 0.1, 0.1, 1.0, 1.0, 1.0, 0.1, 0.1, 0.1, 0.01, 0.01, 0.01, 0.1])
 """Typical size of a change of each state component (v [m/s], omega [rad/s], n [-], r_C [m],
@@ -494,9 +496,25 @@ def _lsq_jac(state):
     return state.f_info.jac.as_matrix()
 
 
+class DampedGaussNewton(optx.AbstractGaussNewton):
+    """Gauss-Newton with step limiting: the full GN step is shortened by a backtracking Armijo
+    line search (halving until the loss decreases sufficiently). Plain `optimistix.GaussNewton`
+    accepts every full step; from a start 35-50% off, its first steps land in parameter regions
+    where the record's integration is stiff and the loss is far larger (see docs/identification.md)."""
+
+    rtol: float
+    atol: float
+    norm: Callable = optx.max_norm
+    descent: optx.NewtonDescent = optx.NewtonDescent()
+    search: optx.BacktrackingArmijo = optx.BacktrackingArmijo(decrease_factor=0.5, slope=0.1, step_init=1.0)
+    verbose: Callable = lambda **kw: None
+
+
 def _lsq_solver(name, rtol, atol):
     if name == "lm":
         return optx.LevenbergMarquardt(rtol=rtol, atol=atol)
+    if name == "gn-damped":
+        return DampedGaussNewton(rtol=rtol, atol=atol)
     return optx.GaussNewton(rtol=rtol, atol=atol)
 
 
@@ -552,6 +570,7 @@ def fit(
     max_steps: int = 200_000,
     learning_rate: float = 0.02,
     uncertainty: bool = True,
+    max_time: float | None = None,
     callback: Callable[[int, float, dict[str, float]], None] | None = None,
 ) -> FitResult:
     """Fit the free parameters to measured trajectories.
@@ -562,7 +581,8 @@ def fit(
         params0: starting parameters (also the values of every parameter that is not free).
         free: names of the parameters to fit (any float fields of `CeltParams` except the
             reading switches and the per-record omega_pi, q_pi).
-        optimiser: ``"lm"`` (optimistix Levenberg-Marquardt), ``"gn"`` (Gauss-Newton), both with
+        optimiser: ``"lm"`` (optimistix Levenberg-Marquardt), ``"gn"`` (plain Gauss-Newton, full
+            steps), ``"gn-damped"`` (Gauss-Newton with a backtracking line search), all with
             forward-mode Jacobians; ``"adam"`` or ``"lbfgs"`` (optax, reverse-mode gradients).
         weights: extra weight per observation kind (default 1; residuals are already /sigma).
         transforms: per-parameter transforms overriding `DEFAULT_TRANSFORMS` (else `Positive`).
@@ -580,6 +600,8 @@ def fit(
         sim_rtol, sim_atol, max_steps: integrator settings.
         learning_rate: Adam step size in z (log-relative units for `Positive` parameters).
         uncertainty: compute standard errors, intervals and correlations.
+        max_time: wall-clock budget [s] for the iterations (checked after each iteration;
+            compilation included); the fit stops unconverged when it is spent.
         callback: called as ``callback(iteration, loss, values)`` after each iteration (progress).
 
     Returns:
@@ -587,7 +609,7 @@ def fit(
     """
     if optimiser not in OPTIMISERS:
         raise ValueError(f"fit: optimiser must be one of {OPTIMISERS}, got {optimiser!r}")
-    mode = "fwd" if optimiser in ("lm", "gn") else "rev"
+    mode = "fwd" if optimiser in ("lm", "gn", "gn-damped") else "rev"
     free = tuple(free)
     prob, z = _build(
         data,
@@ -633,6 +655,8 @@ def fit(
             if bool(done):
                 converged = result == optx.RESULTS.successful
                 break
+            if max_time is not None and iter_marks[-1] - t_start > max_time:
+                break
         z = prob.unflatten(z)
         lsq_state = state
     else:
@@ -654,6 +678,8 @@ def fit(
                 break
             if it >= 5 and abs(loss_hist[-6] - loss_hist[-1]) <= rtol * abs(loss_hist[-1]) + 1e-14:
                 converged = True
+                break
+            if max_time is not None and iter_marks[-1] - t_start > max_time:
                 break
     loop_time = time.perf_counter() - t_start
     iter_times = np.diff(np.asarray(iter_marks))
@@ -777,23 +803,34 @@ def finite_time_lyapunov(
 def gradient_norm_vs_window(
     data: MeasuredData,
     params0: CeltParams,
-    lengths: Sequence[int],
+    lengths: Sequence[int] | None = None,
     *,
     free: Sequence[str] = ("mu", "k_r", "b_Ts", "m_Ts"),
+    sim_rtol: float = 1e-8,
+    sim_atol: float = 1e-10,
+    max_steps: int = 200_000,
 ) -> tuple[np.ndarray, np.ndarray]:
     """|d loss / d z_params| of a single-shooting fit on the first ``L`` samples of record 0.
 
-    Args: data, params0, lengths: window lengths in samples. Returns (T [s] (L,), gradient
-    norms (L,)); compare with e^{lambda T} from `finite_time_lyapunov`.
+    One forward-mode pass over the whole record gives the residuals r_j and their parameter
+    sensitivities dr_j/dz; the gradient of the loss on the first L samples is the partial sum
+    sum_{j<=L} r_j dr_j/dz, so every window length costs one compilation and one solve.
+
+    Args: data, params0, lengths: window lengths in samples (default: every sample). Returns
+    (T [s] (L,), gradient norms (L,)); compare with e^{lambda T} from `finite_time_lyapunov`.
     """
     tr = data.trajectories[0]
-    Ts, norms = [], []
-    for L in lengths:
-        sub = dataclasses.replace(tr, ts=tr.ts[: L + 1], obs={k: v[: L + 1] for k, v in tr.obs.items()})
-        prob, z = _build(
-            MeasuredData((sub,)), params0, tuple(free), {}, {}, 1, "data", False, 1.0, "rev", 1e-8, 1e-10, 200_000
-        )
-        g = eqx.filter_jit(jax.grad(lambda zz, pr: pr.loss(zz)))(z, prob)
-        norms.append(float(np.linalg.norm(np.asarray(g["params"]))))
-        Ts.append(float(sub.ts[-1] - sub.ts[0]))
-    return np.asarray(Ts), np.asarray(norms)
+    sub = MeasuredData((tr,), getattr(data, "meta", {}))
+    prob, z = _build(sub, params0, tuple(free), {}, {}, 1, "data", False, 1.0, "fwd", sim_rtol, sim_atol, max_steps)
+    zf = z["params"]
+    r, J = (np.asarray(a) for a in _value_and_jacobian(prob, zf))
+    n1 = len(tr.ts)
+    per_sample, i = np.zeros((n1, J.shape[1])), 0
+    for _kind, ob in prob.records[0].obs.items():  # residual blocks: kind-major, then sample-major
+        m = n1 * ob.shape[-1]
+        per_sample += (r[i : i + m, None] * J[i : i + m]).reshape(n1, ob.shape[-1], -1).sum(axis=1)
+        i += m
+    g = np.cumsum(per_sample, axis=0)  # (n1, P): gradient of the loss on samples 0..L
+    lengths = np.arange(1, n1) if lengths is None else np.asarray(lengths)
+    norms = np.linalg.norm(g[lengths], axis=1)
+    return np.asarray(tr.ts[lengths] - tr.ts[0]), norms

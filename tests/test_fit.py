@@ -87,6 +87,9 @@ def test_lm_recovers_imu_short_record(short_imu):
     assert all(np.isfinite(list(res.stderr.values())))
     assert np.allclose(np.diag(res.corr), 1.0)
     assert res.params.mu == pytest.approx(res.values["mu"])
+    # the same compiled step (no retrace: same shapes and settings) under a spent time budget
+    short = jc.fit(data, PAPER, free=FREE, optimiser="lm", max_iter=60, max_time=0.0)
+    assert short.n_iter == 1 and not short.converged
 
 
 def test_cli_fit(tmp_path, short_imu, capsys):
@@ -127,7 +130,7 @@ def test_must_show_1_recovery(kinds):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("optimiser", ["lbfgs", "adam", "gn"])
+@pytest.mark.parametrize("optimiser", ["lbfgs", "adam", "gn", "gn-damped"])
 def test_other_optimisers_reduce_loss(short_imu, optimiser):
     res = jc.fit(short_imu.subset(["omega"]), PAPER, free=FREE, optimiser=optimiser, max_iter=40)
     # all must make progress on the same problem; only LM/GN are expected to converge tightly
@@ -142,3 +145,19 @@ def test_multiple_shooting_optimised_states(short_imu):
     )
     assert max(res.relative_error(TRUE).values()) < 0.01
     assert res.continuity < 1e-8
+
+
+@pytest.mark.slow
+def test_gradient_norm_vs_window_matches_reverse_mode(short_imu):
+    """The partial sums of r_j dr_j/dz are the gradients of the truncated single-shooting losses."""
+    import jax
+
+    data = short_imu.subset(["omega"])
+    T, g = F.gradient_norm_vs_window(data, PAPER, [20, 50], free=FREE)
+    tr = data.trajectories[0]
+    assert T == pytest.approx([tr.ts[20], tr.ts[50]])
+    sub = dataclasses.replace(tr, ts=tr.ts[:21], obs={k: v[:21] for k, v in tr.obs.items()})
+    prob, z = F._build(jc.MeasuredData((sub,)), PAPER, FREE, {}, {}, 1, "data", False, 1.0, "rev", 1e-8, 1e-10, 200_000)
+    ref = float(jnp.linalg.norm(jax.grad(lambda zz: prob.loss(zz))(z)["params"]))
+    assert g[0] == pytest.approx(ref, rel=1e-5)
+    assert g[1] > g[0]
