@@ -187,6 +187,13 @@ def _fill_implicit_tols(solver, rtol, atol):
     # it cannot reach through our wrapper, so do it before wrapping.
     if isinstance(solver, diffrax.AbstractImplicitSolver):
         rf = solver.root_finder
+        if isinstance(rf, diffrax.VeryChord) and rf.rtol is use_stepsize_tol and rf.atol is use_stepsize_tol:
+            # diffrax's default root finder reuses one Jacobian per step. The friction law's
+            # Jacobian changes by ~1/sqrt(eps) within a step during stick-slip, so the chord
+            # iteration diverges and steps are rejected en masse (Kvaerno5, one period from rest,
+            # omega_pi = 17: 2005 accepted + 2417 rejected steps, vs 293 + 103 with full Newton;
+            # docs/performance.md section 3). Use full Newton unless the user chose a root finder.
+            rf = optx.Newton(rtol=rtol, atol=atol, norm=optx.rms_norm)
         for attr, val in (("rtol", rtol), ("atol", atol), ("norm", optx.rms_norm)):
             if getattr(rf, attr, None) is use_stepsize_tol:
                 rf = eqx.tree_at(lambda r, attr=attr: getattr(r, attr), rf, val)
