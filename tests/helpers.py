@@ -7,7 +7,9 @@ import numpy as np
 
 def tree_allclose(x, y, *, rtol=1e-5, atol=1e-8):
     lx, ly = jax.tree_util.tree_leaves(x), jax.tree_util.tree_leaves(y)
-    return len(lx) == len(ly) and all(np.allclose(np.asarray(a), np.asarray(b), rtol=rtol, atol=atol) for a, b in zip(lx, ly))
+    return len(lx) == len(ly) and all(
+        np.allclose(np.asarray(a), np.asarray(b), rtol=rtol, atol=atol) for a, b in zip(lx, ly)
+    )
 
 
 def rel_err(a, b):
