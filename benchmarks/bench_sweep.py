@@ -58,6 +58,95 @@ def scipy_lane(y0, ts, P, B, Bi, rtol, atol):
     return sol.y.T, sol.nfev, sol.status
 
 
+def time_jaxcelt(p, vals, transient, a, scheduler, stop):
+    """Compile apart, then the sweep; step-slot accounting from the pool's loop counters."""
+    from jaxcelt.sweep import SweepConfig, lanes_params, run_lanes
+
+    kw = dict(
+        sample_periods=a.sample, rtol=a.rtol, atol=a.atol, chunk_size=a.chunk_size, sort_by_cost=True,
+        scheduler=scheduler, width=a.width, stop_on_invalid=stop,
+    )  # fmt: skip
+    cs = min(a.chunk_size, len(vals))
+    t = time.perf_counter()
+    if scheduler == "pool":
+        cfg = SweepConfig(
+            transient_periods=transient, sample_periods=a.sample, rtol=a.rtol, atol=a.atol, stop_on_invalid=stop
+        )
+        y0 = np.tile(np.asarray(jc.initial_state(p)), (cs, 1))
+        run_lanes(lanes_params(p, "omega_pi", vals[:cs]), y0, cfg, pad_to=cs, width=a.width, compile_only=True)
+        compile_note = "compile only (all lanes marked padding)"
+    else:
+        bifurcation(p, vals[:cs], transient_periods=0, **kw)
+        compile_note = "compile + a sample-periods-only run of one chunk"
+    t_compile = time.perf_counter() - t
+    chunks = []
+    t = time.perf_counter()
+    r = bifurcation(p, vals, transient_periods=transient, on_chunk=lambda ci, c: chunks.append(c), **kw)
+    t_run = time.perf_counter() - t
+    useful = int(r.num_steps.sum())
+    if scheduler == "pool":
+        slots = int(sum(int(c["pool_iterations"][0]) * int(c["pool_width"][0]) for c in chunks))
+    else:
+        slots = int(sum(int(c["num_steps"].max()) * len(c["num_steps"]) for c in chunks))
+    per_period = r.num_steps / (transient + a.sample)
+    inval = ~r.valid
+    # Tsit5: 6 RHS per step (FSAL) + 1 normal-force evaluation of the validity monitor
+    return dict(
+        seconds=t_run,
+        compile_seconds=t_compile,
+        compile_note=compile_note,
+        total_steps=useful,
+        step_slots=slots,
+        wasted_slot_fraction=1 - useful / slots,
+        us_per_rhs_slot=t_run / (slots * 7) * 1e6,
+        us_per_useful_rhs=t_run / (useful * 7) * 1e6,
+        steps_per_period_percentiles_0_25_50_75_90_100=[
+            float(x) for x in np.percentile(per_period, [0, 25, 50, 75, 90, 100])
+        ],
+        lanes_invalid=int(inval.sum()),
+        steps_in_invalid_lanes_fraction=float(r.num_steps[inval].sum() / max(useful, 1)),
+        status_counts={int(k): int(v) for k, v in zip(*np.unique(r.status, return_counts=True))},
+    )
+
+
+def eval_costs(p, vals, width, reps=2000):
+    """Per-lane cost of one vector-field evaluation and one validity-monitor evaluation
+    (normal force), vmapped over `width` lanes inside one jitted loop (no dispatch)."""
+    import jax.numpy as jnp
+
+    from jaxcelt.contact import get_contact_law
+    from jaxcelt.model import vector_field
+    from jaxcelt.solve import _invalid_kind
+    from jaxcelt.sweep import lanes_params
+
+    law = get_contact_law(None)
+    pb = lanes_params(p, "omega_pi", vals[:width])
+    y0 = jnp.tile(jnp.asarray(jc.initial_state(p)), (pb.omega_pi.shape[0], 1))
+
+    def loop(fn):
+        def body(i, y):
+            out = jax.vmap(lambda pp, yy: fn(0.1 * i, yy, pp))(pb, y)
+            return y + 1e-30 * jnp.sum(jnp.atleast_2d(out.T).T[..., :1], axis=-1, keepdims=True)
+
+        return jax.jit(lambda y: jax.lax.fori_loop(0, reps, body, y))
+
+    res = {}
+    for name, fn in (
+        ("rhs", lambda t, y, pp: vector_field(t, y, pp, law)),
+        ("monitor", lambda t, y, pp: _invalid_kind(t, y, pp, law)[1]),
+    ):
+        f = loop(fn)
+        jax.block_until_ready(f(y0))
+        t = time.perf_counter()
+        jax.block_until_ready(f(y0))
+        res[f"{name}_us_per_lane"] = (time.perf_counter() - t) / (reps * pb.omega_pi.shape[0]) * 1e6
+    res["monitor_share_of_step"] = res["monitor_us_per_lane"] / (
+        6 * res["rhs_us_per_lane"] + res["monitor_us_per_lane"]
+    )
+    res["width"] = int(pb.omega_pi.shape[0])
+    return res
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--n-freq", type=int, default=400)
@@ -65,7 +154,9 @@ def main():
     ap.add_argument("--sample", type=int, default=100)
     ap.add_argument("--rtol", type=float, default=1e-8)
     ap.add_argument("--atol", type=float, default=1e-10)
-    ap.add_argument("--chunk-size", type=int, default=100)
+    ap.add_argument("--chunk-size", type=int, default=400, help="lanes per pool launch (resumable unit)")
+    ap.add_argument("--width", type=int, default=32, help="pool slots (vmap width)")
+    ap.add_argument("--with-chunks", action="store_true", help="also time the old chunk scheduler")
     ap.add_argument("--subset", type=int, default=4, help="lanes for the lane-by-lane methods (extrapolated)")
     ap.add_argument("--subset-periods", type=int, default=30, help="periods for the lane-by-lane methods")
     ap.add_argument("--quick", action="store_true", help="40 freq x 40 periods")
@@ -73,6 +164,7 @@ def main():
     a = ap.parse_args()
     if a.quick:
         a.n_freq, a.periods, a.sample, a.subset_periods = 40, 40, 10, 20
+        a.with_chunks = True
     transient = a.periods - a.sample
     V = versions()
     print(" ".join(f"{k}={v}" for k, v in V.items()), flush=True)
@@ -82,7 +174,13 @@ def main():
     res: dict = dict(
         versions=V,
         config=dict(
-            n_freq=a.n_freq, periods=a.periods, sample=a.sample, rtol=a.rtol, atol=a.atol, chunk_size=a.chunk_size
+            n_freq=a.n_freq,
+            periods=a.periods,
+            sample=a.sample,
+            rtol=a.rtol,
+            atol=a.atol,
+            chunk_size=a.chunk_size,
+            width=a.width,
         ),
         note="2 shared CPU cores (other jobs running): timings are noisy, +-30%",
     )
@@ -96,34 +194,16 @@ def main():
     rhs_numba = (time.perf_counter() - t) / 2_000_000
     res["numba_rhs_us"] = rhs_numba * 1e6
 
-    # 1. jaxcelt vmapped: compile (transient 0, 1-period horizon: same static config) then run
-    kw = dict(sample_periods=a.sample, rtol=a.rtol, atol=a.atol, chunk_size=a.chunk_size, sort_by_cost=True)
-    t = time.perf_counter()
-    bifurcation(p, vals[: a.chunk_size], transient_periods=0, **kw)
-    t_compile = time.perf_counter() - t
-    t = time.perf_counter()
-    r = bifurcation(p, vals, transient_periods=transient, **kw)
-    t_jax = time.perf_counter() - t
-    # step slots: each chunk's while loop runs max(num_steps) iterations for all its lanes
-    order = np.argsort(1.0 / vals, kind="stable")
-    slots = sum(
-        int(r.num_steps[order[i : i + a.chunk_size]].max()) * len(order[i : i + a.chunk_size])
-        for i in range(0, len(vals), a.chunk_size)
-    )
-    useful = int(r.num_steps.sum())
-    # Tsit5: 6 RHS per step (FSAL) + 1 normal-force evaluation of the validity monitor
-    rhs_slots = slots * 7
-    res["jaxcelt_vmapped"] = dict(
-        seconds=t_jax,
-        compile_and_small_run_seconds=t_compile,
-        total_steps=useful,
-        step_slots=slots,
-        wasted_slot_fraction=1 - useful / slots,
-        us_per_rhs_slot=t_jax / rhs_slots * 1e6,
-        us_per_useful_rhs=t_jax / (useful * 7) * 1e6,
-        failed_lanes=int(np.sum(r.status != 0)),
-    )
-    print("jaxcelt vmapped", res["jaxcelt_vmapped"], flush=True)
+    # 1. jaxcelt vmapped: lane pool (default), with and without stop_on_invalid; the old
+    #    chunk scheduler (every slot waits for the chunk's slowest lane) for comparison
+    runs = [("pool", False), ("pool", True)] + ([("chunks", False)] if a.with_chunks else [])
+    for sched, stop in runs:
+        key = f"jaxcelt_{sched}" + ("_stop_on_invalid" if stop else "")
+        res[key] = time_jaxcelt(p, vals, transient, a, sched, stop)
+        print(key, res[key], flush=True)
+    res["jaxcelt_vmapped"] = res["jaxcelt_pool_stop_on_invalid"]  # the main-job setting
+    res["per_lane_eval_cost"] = eval_costs(p, vals, a.width)
+    print("per-lane evaluation cost", res["per_lane_eval_cost"], flush=True)
 
     # 4. numba DP5 ensemble (all lanes, all periods)
     sub = np.linspace(0, a.n_freq - 1, a.subset).astype(int)
@@ -188,17 +268,29 @@ def main():
         scipy_dop853=float(np.max(np.abs(sp_a - ref))),
     )
     print("accuracy", res["accuracy_max_abs_err_5_periods_vs_dop853_1e-12"], flush=True)
-    jv = res["jaxcelt_vmapped"]
+    jv = res["jaxcelt_pool"]  # same work as the loops (every lane integrated to the end)
+    js = res["jaxcelt_pool_stop_on_invalid"]
+    scale = (400 * 300) / (a.n_freq * a.periods)
+    sp = res["scipy_dop853_numba_rhs"]["extrapolated_seconds"]
     res["summary"] = dict(
-        jaxcelt_vmapped_s=jv["seconds"],
+        jaxcelt_pool_s=jv["seconds"],
+        jaxcelt_pool_stop_on_invalid_s=js["seconds"],
+        jaxcelt_chunks_s=res.get("jaxcelt_chunks", {}).get("seconds"),
+        compile_s=jv["compile_seconds"],
         # the issue's target is 400 frequencies x 300 periods; smaller runs are scaled linearly
-        extrapolated_400x300_s=jv["seconds"] * (400 * 300) / (a.n_freq * a.periods),
-        target_120s_met=bool(jv["seconds"] * (400 * 300) / (a.n_freq * a.periods) <= 120),
-        speedup_vs_scipy_numba_loop=res["scipy_dop853_numba_rhs"]["extrapolated_seconds"] / jv["seconds"],
+        extrapolated_400x300_pool_s=jv["seconds"] * scale,
+        extrapolated_400x300_pool_stop_on_invalid_s=js["seconds"] * scale,
+        extrapolated_400x300_numba_ensemble_s=None,
+        target_120s_met=bool(js["seconds"] * scale <= 120),
+        speedup_vs_scipy_numba_loop=sp / jv["seconds"],
+        speedup_vs_scipy_numba_loop_stop_on_invalid=sp / js["seconds"],
         speedup_vs_jaxcelt_lane_by_lane=res["jaxcelt_lane_by_lane"]["extrapolated_seconds"] / jv["seconds"],
         numba_ensemble_s=t_nb,
         per_rhs_ratio_jax_slot_vs_numba_cpu=jv["us_per_rhs_slot"] / res["numba_dp5_ensemble"]["us_per_rhs_cpu"],
+        per_rhs_ratio_jax_useful_vs_numba_cpu=jv["us_per_useful_rhs"] / res["numba_dp5_ensemble"]["us_per_rhs_cpu"],
+        wall_ratio_pool_vs_numba_ensemble=jv["seconds"] / t_nb,
     )
+    res["summary"]["extrapolated_400x300_numba_ensemble_s"] = t_nb * scale
     print(json.dumps(res["summary"], indent=1), flush=True)
     a.out.mkdir(parents=True, exist_ok=True)
     tag = "quick" if a.quick else f"{a.n_freq}x{a.periods}"
@@ -209,24 +301,27 @@ def main():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    names = ["jaxcelt\nvmapped", "numba DP5\nensemble", "jaxcelt\nlane by lane*", "scipy DOP853\n+ numba RHS*"]
-    secs = [
-        jv["seconds"],
-        t_nb,
-        res["jaxcelt_lane_by_lane"]["extrapolated_seconds"],
-        res["scipy_dop853_numba_rhs"]["extrapolated_seconds"],
-    ]
-    fig, ax = plt.subplots(figsize=(7.5, 4.2), constrained_layout=True)
-    bars = ax.bar(names, secs, color=["tab:blue", "tab:green", "tab:cyan", "tab:orange"])
+    names = ["jaxcelt pool", "jaxcelt pool\nstop_on_invalid"]
+    secs = [jv["seconds"], js["seconds"]]
+    colors = ["tab:blue", "tab:purple"]
+    if "jaxcelt_chunks" in res:
+        names.append("jaxcelt chunks\n(before)")
+        secs.append(res["jaxcelt_chunks"]["seconds"])
+        colors.append("tab:gray")
+    names += ["numba DP5\nensemble", "jaxcelt\nlane by lane*", "scipy DOP853\n+ numba RHS*"]
+    secs += [t_nb, res["jaxcelt_lane_by_lane"]["extrapolated_seconds"], sp]
+    colors += ["tab:green", "tab:cyan", "tab:orange"]
+    fig, ax = plt.subplots(figsize=(9, 4.4), constrained_layout=True)
+    bars = ax.bar(names, secs, color=colors)
     ax.set_yscale("log")
     for b_, s_ in zip(bars, secs):
-        ax.text(b_.get_x() + b_.get_width() / 2, s_ * 1.1, f"{s_:.0f} s", ha="center", fontsize=10)
+        ax.text(b_.get_x() + b_.get_width() / 2, s_ * 1.1, f"{s_:.3g} s", ha="center", fontsize=10)
     if (a.n_freq, a.periods) == (400, 300):
         ax.axhline(120, color="k", ls="--", lw=0.8, label="target 120 s")
         ax.legend(fontsize=9)
     ax.set_ylabel("wall time [s] (log)")
     ax.set_title(
-        f"{a.n_freq} frequencies x {a.periods} periods, rtol {a.rtol:g}, 2 shared CPU cores\n* extrapolated from {len(sub)} lanes x {a.subset_periods} periods; compile excluded",
+        f"{a.n_freq} frequencies x {a.periods} periods, rtol {a.rtol:g}, 2 shared CPU cores\n* extrapolated from {len(sub)} lanes x {a.subset_periods} periods; compile excluded; jax {jax.__version__}",
         fontsize=10,
     )
     fig.savefig(a.out / f"bench_sweep_{tag}.png", dpi=130)

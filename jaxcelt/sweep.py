@@ -9,15 +9,26 @@ steps exactly onto every t_k.
 
 Execution model
 ---------------
-* Lanes are processed in chunks of ``chunk_size``; a chunk is **one** jitted
-  ``jax.vmap`` of the one-lane kernel (`_lane`), so the compile happens once per chunk
-  shape and static configuration. Inside a chunk the vmapped while loop runs until its
-  slowest lane is done; finished lanes are masked, hence a lane's result does not depend on
-  its neighbours (a lane that hits ``max_steps`` is flagged and the others are bitwise
-  unchanged). Adjacent parameter values cost about the same, so chunks of neighbouring
-  values waste few step slots; ``sort_by_cost=True`` additionally orders lanes by a cost
-  proxy (number of forcing periods per unit time is the same for all lanes, so the proxy is
-  the lane's time span t1 - t0, i.e. 1/omega_pi for frequency sweeps).
+* Lanes are processed in chunks of ``chunk_size`` (the unit of resumable writing). The
+  default ``scheduler="pool"`` runs a chunk as **one** jitted while loop over ``width``
+  batch slots (`_pool`): each iteration makes one step in every slot (the step is diffrax's
+  own loop body -- `MonitoredSolver` step, PID + ClipStepSizeController, the same first-step
+  choice -- so a lane equals `jaxcelt.simulate` step for step), and a slot whose lane
+  finished is refilled with the next lane at once. Step slots are therefore only wasted in
+  the final drain, not for every lane until the slowest one is done. Lane order (and hence
+  slot assignment) is fixed and the per-lane arithmetic does not depend on the slot, so
+  results are deterministic and a lane's result does not depend on its neighbours (a lane
+  that hits ``max_steps`` is flagged and the others are bitwise unchanged).
+  ``sort_by_cost=True`` orders lanes by the cost proxy 1/omega_pi (time span of a period),
+  longest first, so the drain runs on cheap lanes. The optional Lyapunov stage then runs
+  vmapped over the successful lanes in groups of ``width`` ordered by the measured
+  main-solve step count.
+* ``scheduler="chunks"`` (the previous engine): a chunk is one ``jax.vmap`` of `simulate`;
+  the vmapped while loop runs until the chunk's slowest lane is done.
+* ``stop_on_invalid=True`` ends a lane at the first accepted step whose end state is
+  invalid (lift-off N <= 0, n3 <= 0, denominator <= 0; the model does not hold past it):
+  status 2, samples after the stop inf, no Lyapunov exponent. Default False (integrate on
+  and report where validity was lost), as in `simulate`.
 * Chunks are sharded over all local JAX devices with `jax.shard_map` on a 1-D
   ``Mesh(jax.local_devices(), ("lanes",))``: each device runs its own vmapped solve over its
   slice of the chunk (no cross-device synchronisation inside the time loop). The chunk is
@@ -52,9 +63,11 @@ from typing import Any
 
 import diffrax
 import equinox as eqx
+import equinox.internal as eqxi
 import jax
 import jax.numpy as jnp
 import numpy as np
+from diffrax._term import WrapTerm  # what diffeqsolve wraps terms in (not re-exported)
 
 from . import _config  # noqa: F401
 from ._types import Array
@@ -62,7 +75,7 @@ from .contact import AbstractContactLaw, get_contact_law
 from .diagnostics import centre_position
 from .lyapunov import celt_lyapunov
 from .params import PARAM_NAMES, CeltParams
-from .solve import DEFAULT_SOLVER, simulate
+from .solve import DEFAULT_SOLVER, MonitoredSolver, _Field, _fill_implicit_tols, simulate
 from .state import initial_state
 
 __all__ = [
@@ -92,6 +105,8 @@ class SweepConfig:
     solver: Any = DEFAULT_SOLVER
     contact_law: Any = None
     t0: float = 0.0
+    stop_on_invalid: bool = False
+    """end a lane at the first accepted step whose end state is invalid (status 2, later samples inf)"""
 
     def __post_init__(self):
         for name in ("transient_periods", "sample_periods", "lyapunov_periods", "max_steps"):
@@ -121,6 +136,7 @@ class SweepConfig:
             step_size_controller="PIDController + ClipStepSizeController(step_ts=section times)",
             contact_law=f"{type(law).__name__}(rolling_resistance={law.rolling_resistance})",
             t0=float(self.t0),
+            stop_on_invalid=int(bool(self.stop_on_invalid)),
         )
 
 
@@ -130,9 +146,11 @@ class SweepResult(eqx.Module):
     Attributes (L = lanes, S = sample_periods):
         values: swept parameter value per lane, (L,)
         t_samples: stroboscopic times [s], (L, S)
-        samples: states at the section, (L, S, 13) (inf after a failed solve)
+        samples: states at the section, (L, S, 13) (inf after a failed solve or a stop at an
+            invalid state)
         y_final: last sample (L, 13) -- the start of a continuation step
-        status: `jaxcelt.STATUS` code, (L,); success = status == 0
+        status: `jaxcelt.STATUS` code, (L,); success = status == 0; 2 = stopped at the first
+            invalid state (``stop_on_invalid=True``)
         valid: model stayed valid (N > 0, n3 > 0, denominator > 0) on all accepted steps, (L,)
         first_invalid_t [s], first_invalid_kind (`jaxcelt.INVALID_KINDS`), (L,)
         min_N [N], max_tilt [rad]: over all accepted steps (transient included), (L,)
@@ -191,6 +209,17 @@ def lanes_params(params: CeltParams, name: str, values: Array) -> CeltParams:
     return eqx.tree_at(lambda p: getattr(p, name), pb, values)
 
 
+def _extras(ys: Array, p: CeltParams) -> dict[str, Array]:
+    """Global motion of O from one lane's samples (S, 13); samples after a stop (inf) ignored."""
+    r_O = jax.vmap(centre_position, in_axes=(0, None))(ys, p)
+    dist = jnp.linalg.norm(r_O[:, :2] - r_O[0:1, :2], axis=-1)
+    fin = jnp.isfinite(dist)
+    last = jnp.max(jnp.where(fin, jnp.arange(dist.shape[0]), -1))
+    drift = jnp.where(last >= 0, dist[jnp.maximum(last, 0)], jnp.nan)
+    exc = jnp.where(last >= 0, jnp.max(jnp.where(fin, dist, -jnp.inf)), jnp.nan)
+    return dict(drift=drift, max_excursion=exc, r_O=r_O)
+
+
 def _lane(p: CeltParams, y0: Array, transient: Array, cfg: SweepConfig) -> dict[str, Array]:
     """One lane: transient, exact stroboscopic samples, extras, optional Lyapunov exponent.
 
@@ -212,10 +241,9 @@ def _lane(p: CeltParams, y0: Array, transient: Array, cfg: SweepConfig) -> dict[
         max_steps=cfg.max_steps,
         contact_law=cfg.contact_law,
         exact_ts=True,
+        stop_on_invalid=cfg.stop_on_invalid,
     )
     ys = sol.ys
-    r_O = jax.vmap(centre_position, in_axes=(0, None))(ys, p)
-    dxy = r_O[:, :2] - r_O[0:1, :2]
     out = dict(
         t_samples=ts,
         samples=ys,
@@ -226,10 +254,8 @@ def _lane(p: CeltParams, y0: Array, transient: Array, cfg: SweepConfig) -> dict[
         first_invalid_kind=sol.validity.first_invalid_kind,
         min_N=sol.validity.min_N,
         max_tilt=sol.validity.max_tilt,
-        drift=jnp.linalg.norm(dxy[-1]),
-        max_excursion=jnp.max(jnp.linalg.norm(dxy, axis=-1)),
         num_steps=sol.num_steps,
-        r_O=r_O,
+        **_extras(ys, p),
     )
     if cfg.lyapunov_periods > 0:
         ok = sol.status == 0
@@ -260,6 +286,261 @@ def _chunk(pb: CeltParams, y0b: Array, transient: Array, cfg: SweepConfig, mesh:
     return jax.shard_map(run, mesh=mesh, in_specs=(spec, spec), out_specs=spec, check_vma=False)(pb, y0b)
 
 
+# --------------------------------------------------------------------------------------
+# Lane pool: one jitted while loop over a fixed number of batch slots that are refilled
+# with the next lane as soon as a lane finishes (no slot waits for the chunk's slowest lane).
+# --------------------------------------------------------------------------------------
+
+
+def _pool_parts(cfg: SweepConfig):
+    law = get_contact_law(cfg.contact_law)
+    solver = MonitoredSolver(solver=_fill_implicit_tols(cfg.solver, cfg.rtol, cfg.atol), law=law)
+    # diffeqsolve wraps every term in WrapTerm(term, direction); with it, PIDController.init
+    # takes diffrax's fixed first trial step (0.01) instead of the ODETerm-only heuristic --
+    # mirrored here so that lanes equal `simulate` step for step
+    term = WrapTerm(diffrax.ODETerm(_Field(law)), jnp.asarray(1))
+    return law, solver, term
+
+
+def _controller(tols: Array, ts: Array):
+    # the same controller `simulate(..., exact_ts=True)` builds; the tolerances are traced
+    # there too (jit arguments): as constants XLA would fold them differently (1-ulp changes
+    # of the error norm flip accept/reject decisions and the lane would not equal `simulate`)
+    pid = diffrax.PIDController(rtol=tols[0], atol=tols[1])
+    return diffrax.ClipStepSizeController(pid, step_ts=ts)
+
+
+def _lane_init(cfg: SweepConfig, p: CeltParams, y0: Array, ts: Array, tols: Array) -> dict[str, Any]:
+    """diffeqsolve's initialisation (controller.init picks the first step, solver.init)."""
+    _, solver, term = _pool_parts(cfg)
+    t0 = jnp.asarray(cfg.t0, jnp.float64)
+    t1 = ts[-1]
+    ctrl = _controller(tols, ts)
+    tnext, cstate = ctrl.init(term, t0, t1, y0, None, p, solver.func, solver.error_order(term))
+    tnext = jnp.minimum(tnext, t1)
+    sstate = solver.init(term, t0, tnext, y0, p)
+    floor = t1
+    for _ in range(100):  # diffrax's t1_clip_floor: t1 - 100 ULP
+        floor = eqxi.prevbefore(floor)
+    k0 = (ts[0] <= t0).astype(jnp.int32)  # a section time at t0 is the initial state itself
+    stop0 = jnp.asarray(cfg.stop_on_invalid) & (sstate[1].first_invalid_kind > 0)
+    return dict(
+        p=p,
+        ts=ts,
+        tols=tols,
+        t1=t1,
+        floor=floor,
+        y=y0,
+        tprev=t0,
+        tnext=tnext,
+        sstate=sstate,
+        cstate=cstate,
+        result=diffrax.RESULTS.where(stop0, diffrax.RESULTS.event_occurred, diffrax.RESULTS.successful),
+        num_steps=jnp.zeros((), jnp.int32),
+        k=k0,
+        done=stop0,
+    )
+
+
+def _lane_step(cfg: SweepConfig, st: dict[str, Any]) -> tuple[dict[str, Any], Array]:
+    """One iteration of diffrax's integration loop (`diffrax._integrate.loop.body_fun_aux`) for
+    one lane, with exact section saving (the controller steps onto every section time, so the
+    accepted step's end state *is* the sample) and the stop-on-invalid event. Returns the new
+    state and whether this step's end is a section sample."""
+    R = diffrax.RESULTS
+    _, solver, term = _pool_parts(cfg)
+    p, ts, t1 = st["p"], st["ts"], st["t1"]
+    y1, y_err, _, sstate, sres = solver.step(term, st["tprev"], st["tnext"], st["y"], p, st["sstate"], False)
+    y_err = jnp.where(jnp.isnan(y_err), jnp.inf, y_err)
+    keep, tprev, tnext, _, cstate, cres = _controller(st["tols"], ts).adapt_step_size(
+        st["tprev"], st["tnext"], st["y"], y1, p, y_err, solver.error_order(term), st["cstate"]
+    )
+    tprev = jnp.minimum(tprev, t1)
+    tnext = jnp.where(tnext > st["floor"], jnp.where(keep, t1, tprev + 0.5 * (t1 - tprev)), tnext)
+    y = jnp.where(keep, y1, st["y"])
+    sstate = jax.tree_util.tree_map(lambda a, b: jnp.where(keep, a, b), sstate, st["sstate"])
+    sres = R.where(keep, sres, R.successful)
+    result = R.where(st["result"] == R.successful, sres, st["result"])
+    result = R.where(result == R.successful, cres, result)
+    num_steps = st["num_steps"] + 1
+    S = ts.shape[0]
+    hit = keep & (st["k"] < S) & (ts[jnp.minimum(st["k"], S - 1)] <= tprev)
+    k = st["k"] + hit.astype(jnp.int32)
+    if cfg.stop_on_invalid:
+        # diffrax.Event(cond = state invalid) without root finding: ends at the first accepted
+        # step whose end state is invalid -- exactly where the monitor first records it
+        ev = keep & (sstate[1].first_invalid_kind > 0) & (result == R.successful)
+        result = R.where(ev, R.event_occurred, result)
+    ok = result == R.successful
+    done = ~ok | (tprev >= t1) | (num_steps >= cfg.max_steps)
+    new = dict(
+        st,
+        y=y,
+        tprev=tprev,
+        tnext=tnext,
+        sstate=sstate,
+        cstate=cstate,
+        result=result,
+        num_steps=num_steps,
+        k=k,
+        done=done,
+    )
+    return new, hit
+
+
+def _lane_status(st: dict[str, Any]) -> Array:
+    R = diffrax.RESULTS
+    res = st["result"]
+    ok = res == R.successful
+    return jnp.where(
+        ok & (st["tprev"] >= st["t1"]),
+        0,
+        jnp.where(ok, 1, jnp.where(res == R.max_steps_reached, 1, jnp.where(res == R.event_occurred, 2, 3))),
+    ).astype(jnp.int32)
+
+
+def _pool(
+    pb: CeltParams, y0b: Array, live: Array, transient: Array, tols: Array, cfg: SweepConfig, width: int
+) -> dict[str, Array]:
+    """All lanes of ``pb``/``y0b`` through ``width`` slots (refilled as lanes finish).
+
+    ``live`` (L,) bool: False marks padding lanes, which finish at once and cost nothing.
+    """
+    L = y0b.shape[0]
+    B = min(width, L)
+    S = cfg.sample_periods
+    t0 = jnp.asarray(cfg.t0, jnp.float64)
+    T = 2 * jnp.pi / pb.omega_pi
+    ts_all = t0 + T[:, None] * (transient + jnp.arange(S, dtype=jnp.float64))[None, :]
+
+    def _init(p, y, ts, lv):
+        st = _lane_init(cfg, p, y, ts, tols)
+        return dict(st, done=st["done"] | ~lv, at_t0=st["k"] > 0)
+
+    init_v = jax.vmap(_init)
+    step_v = jax.vmap(lambda st: _lane_step(cfg, st))
+
+    def take(idx):
+        j = jnp.minimum(idx, L - 1)
+        return jax.tree_util.tree_map(lambda x: x[j], pb), y0b[j], ts_all[j], live[j]
+
+    out = dict(
+        samples=jnp.full((L, S, 13), jnp.inf),
+        y_final=jnp.full((L, 13), jnp.nan),
+        status=jnp.full((L,), 3, jnp.int32),
+        num_steps=jnp.zeros((L,), jnp.int32),
+        first_invalid_t=jnp.full((L,), jnp.inf),
+        first_invalid_kind=jnp.zeros((L,), jnp.int32),
+        min_N=jnp.full((L,), jnp.nan),
+        max_tilt=jnp.full((L,), jnp.nan),
+    )
+
+    def write_initial(out, lane, st):
+        # section time at t0 (transient 0): the sample is y0. Written in the loop body (not in
+        # the refill branch) so that the big output buffers are only ever updated in place.
+        w = jnp.where((lane < L) & st["at_t0"], lane, L)
+        out["samples"] = out["samples"].at[w, 0].set(st["y"], mode="drop")
+        return out
+
+    def finish(out, lane, st, fin):
+        w = jnp.where(fin & (lane < L), lane, L)
+        mon = st["sstate"][1]
+        for key, val in (
+            ("y_final", st["y"]),
+            ("status", _lane_status(st)),
+            ("num_steps", st["num_steps"]),
+            ("first_invalid_t", mon.first_invalid_t),
+            ("first_invalid_kind", mon.first_invalid_kind.astype(jnp.int32)),
+            ("min_N", mon.min_N),
+            ("max_tilt", mon.max_tilt),
+        ):
+            out[key] = out[key].at[w].set(val, mode="drop")
+        return out
+
+    lane = jnp.arange(B, dtype=jnp.int32)
+    slots = init_v(*take(lane))
+    carry0 = (slots, lane, jnp.asarray(B, jnp.int32), out, jnp.zeros((), jnp.int32))
+
+    def cond(c):
+        return jnp.any(c[1] < L)
+
+    def body(c):
+        slots, lane, nxt, out, iters = c
+        out = write_initial(out, lane, slots)
+        slots = dict(slots, at_t0=jnp.zeros_like(slots["at_t0"]))
+        active = (lane < L) & ~slots["done"]
+        stepped, hit = step_v(slots)
+        slots = jax.tree_util.tree_map(
+            lambda a, b: jnp.where(jnp.reshape(active, active.shape + (1,) * (a.ndim - 1)), a, b), stepped, slots
+        )
+        w = jnp.where(active & hit, lane, L)
+        out["samples"] = out["samples"].at[w, slots["k"] - 1].set(slots["y"], mode="drop")
+        fin = (lane < L) & slots["done"]
+        out = finish(out, lane, slots, fin)
+        rank = jnp.cumsum(fin.astype(jnp.int32)) - 1
+        cand = nxt + rank
+        refill = fin & (cand < L)
+        lane = jnp.where(fin, jnp.where(refill, cand, L), lane).astype(jnp.int32)
+        nxt = nxt + jnp.sum(refill).astype(jnp.int32)
+
+        def do_refill(slots):
+            # a lane that is done at its start (invalid initial state with stop_on_invalid)
+            # finishes in the next iteration without stepping
+            fresh = init_v(*take(lane))
+            return jax.tree_util.tree_map(
+                lambda a, b: jnp.where(jnp.reshape(refill, refill.shape + (1,) * (a.ndim - 1)), a, b), fresh, slots
+            )
+
+        slots = jax.lax.cond(jnp.any(refill), do_refill, lambda s: s, slots)
+        return slots, lane, nxt, out, iters + 1
+
+    _, _, _, out, iters = jax.lax.while_loop(cond, body, carry0)
+    out["t_samples"] = ts_all
+    out["pool_iterations"] = jnp.full((L,), iters)  # loop iterations x slots = step slots paid
+    out["pool_width"] = jnp.full((L,), B)
+    return out
+
+
+def _lyap_lane(p: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig) -> Array:
+    lr = celt_lyapunov(
+        p,
+        y_start,
+        periods=cfg.lyapunov_periods,
+        t0=t_start,
+        contact_law=cfg.contact_law,
+        solver=cfg.solver,
+        rtol=cfg.rtol,
+        atol=cfg.atol,
+        max_steps=cfg.max_steps,  # per period: a bound, not a cost
+    )
+    return lr.exponent
+
+
+def _sharded(run: Callable, mesh: Any, n_in: int) -> Callable:
+    if mesh is None:
+        return run
+    spec = jax.sharding.PartitionSpec("lanes")
+    return jax.shard_map(run, mesh=mesh, in_specs=(spec,) * n_in, out_specs=spec, check_vma=False)
+
+
+@eqx.filter_jit
+def _pool_chunk(
+    pb: CeltParams, y0b: Array, live: Array, transient: Array, tols: Array, cfg: SweepConfig, width: int, mesh: Any
+) -> dict[str, Array]:
+    def run(pb, y0b, live):
+        out = _pool(pb, y0b, live, transient, tols, cfg, width)
+        out.update(jax.vmap(_extras)(out["samples"], pb))
+        return out
+
+    return _sharded(run, mesh, 3)(pb, y0b, live)
+
+
+@eqx.filter_jit
+def _lyap_chunk(pb: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig, mesh: Any) -> Array:
+    run = jax.vmap(lambda p, y, t: _lyap_lane(p, y, t, cfg))
+    return _sharded(run, mesh, 3)(pb, y_start, t_start)
+
+
 def _mesh(devices: Sequence[Any] | None) -> Any:
     devs = list(devices) if devices is not None else jax.local_devices()
     if len(devs) <= 1:
@@ -273,6 +554,10 @@ def _pad(x: np.ndarray, n: int) -> np.ndarray:
     return np.concatenate([x, np.repeat(x[-1:], n - len(x), axis=0)])
 
 
+SCHEDULERS = ("pool", "chunks")
+DEFAULT_WIDTH = 32
+
+
 def run_lanes(
     pb: CeltParams,
     y0b: Array,
@@ -280,14 +565,29 @@ def run_lanes(
     *,
     devices: Sequence[Any] | None = None,
     pad_to: int | None = None,
+    scheduler: str = "pool",
+    width: int | None = None,
+    compile_only: bool = False,
 ) -> dict[str, np.ndarray]:
     """Run one chunk of lanes (batched params and y0 with a leading lane axis) and return numpy arrays.
 
-    Sharded over ``devices`` (default all local devices); padded with copies of the last lane
+    ``scheduler="pool"`` (default): ``width`` batch slots per device (default
+    `DEFAULT_WIDTH`) step in one jitted while loop; a slot whose lane finishes is refilled
+    with the next lane at once, so no slot idles until the slowest lane is done (only the
+    final drain does). The Lyapunov stage (``cfg.lyapunov_periods > 0``) then runs vmapped
+    over the successful lanes in groups of ``width`` ordered by the measured main-solve
+    step count (a cost estimate that needs no pilot run).
+    ``scheduler="chunks"``: the whole chunk is one vmapped `simulate` (every slot runs until
+    the chunk's slowest lane is done).
+
+    Sharded over ``devices`` (default all local devices; lanes are dealt round-robin); padded
     to ``pad_to`` lanes (so a short last chunk reuses the compiled shape) and to a multiple
-    of the device count. Padding lanes cost no extra loop iterations (they copy a lane of
-    the chunk) and are dropped.
+    of the device count. Padding lanes are dropped; in the pool they finish at once.
+    ``compile_only=True`` (pool): every lane marked as padding -- compiles the kernel for
+    these shapes and returns at once (used to time compilation apart from running).
     """
+    if scheduler not in SCHEDULERS:
+        raise ValueError(f"scheduler must be one of {SCHEDULERS}, got {scheduler!r}")
     mesh = _mesh(devices)
     L = int(np.shape(y0b)[0])
     ndev = 1 if mesh is None else mesh.devices.size
@@ -295,8 +595,48 @@ def run_lanes(
     pb_np = jax.tree_util.tree_map(lambda x: _pad(np.asarray(x), Lp), pb)
     y0_np = _pad(np.asarray(y0b, dtype=np.float64), Lp)
     static_cfg = dataclasses.replace(cfg, transient_periods=0)  # transient is traced: no recompiles
-    out = _chunk(pb_np, y0_np, jnp.asarray(float(cfg.transient_periods)), static_cfg, mesh)
-    out = jax.tree_util.tree_map(lambda x: np.asarray(x)[:L], jax.block_until_ready(out))
+    transient = jnp.asarray(float(cfg.transient_periods))
+    if scheduler == "chunks":
+        out = _chunk(pb_np, y0_np, transient, static_cfg, mesh)
+        return jax.tree_util.tree_map(lambda x: np.asarray(x)[:L], jax.block_until_ready(out))
+    W = int(width or DEFAULT_WIDTH)
+    if W < 1:
+        raise ValueError(f"width must be >= 1, got {width!r}")
+    # device d gets lanes d, d + ndev, ... (a mix of cheap and expensive lanes per device)
+    perm = np.arange(Lp).reshape(-1, ndev).T.reshape(-1)
+    live = (np.arange(Lp)[perm] < L) & (not compile_only)
+    nocfg = dataclasses.replace(static_cfg, lyapunov_periods=0)
+    out = _pool_chunk(
+        jax.tree_util.tree_map(lambda x: x[perm], pb_np),
+        y0_np[perm],
+        live,
+        transient,
+        jnp.asarray([cfg.rtol, cfg.atol]),
+        nocfg,
+        min(W, Lp // ndev),
+        mesh,
+    )
+    out = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(out))
+    inv = np.empty_like(perm)
+    inv[perm] = np.arange(Lp)
+    out = {k: v[inv][:L] for k, v in out.items()}
+    out["valid"] = out["first_invalid_kind"] == 0
+    out["lyapunov"] = np.full(L, np.nan)
+    if cfg.lyapunov_periods > 0 and not compile_only:
+        ok = np.flatnonzero(out["status"] == 0)
+        ok = ok[np.argsort(-out["num_steps"][ok], kind="stable")]  # similar cost side by side
+        G = W * ndev
+        for i in range(0, len(ok), G):
+            idx = _pad(ok[i : i + G], G)
+            lam = _lyap_chunk(
+                jax.tree_util.tree_map(lambda x, idx=idx: x[idx], pb_np),
+                out["samples"][idx, 0],
+                out["t_samples"][idx, 0],
+                static_cfg,
+                mesh,
+            )
+            n = min(G, len(ok) - i)
+            out["lyapunov"][idx[:n]] = np.asarray(lam)[:n]
     return out
 
 
@@ -331,6 +671,9 @@ def sweep(
     t0: float = 0.0,
     chunk_size: int | None = None,
     sort_by_cost: bool = False,
+    stop_on_invalid: bool = False,
+    scheduler: str = "pool",
+    width: int | None = None,
     devices: Sequence[Any] | None = None,
     out: str | None = None,
     progress: bool = False,
@@ -349,8 +692,16 @@ def sweep(
         lyapunov_periods: > 0 also integrates the tangent dynamics for that many periods
             after the transient (`jaxcelt.lyapunov.celt_lyapunov`) -> ``lyapunov`` [1/s].
         rtol, atol, max_steps, solver, contact_law, t0: as in `jaxcelt.simulate`.
-        chunk_size: lanes per jitted vmapped solve (default: all lanes in one chunk).
-        sort_by_cost: order lanes by the cost proxy (time span) before chunking.
+        chunk_size: lanes per jitted solve, the unit of resumable writing (default: all
+            lanes in one chunk).
+        sort_by_cost: order lanes by the cost proxy (time span per period, 1/omega_pi),
+            most expensive first, before chunking (the pool then drains on cheap lanes).
+        stop_on_invalid: end each lane at its first invalid state (lift-off, n3 <= 0):
+            status 2, samples after the stop inf, no Lyapunov exponent. Default False (the
+            model is integrated on, validity reported), as in `jaxcelt.simulate`.
+        scheduler: ``"pool"`` (default: ``width`` slots refilled as lanes finish) or
+            ``"chunks"`` (one vmapped `simulate` per chunk); see `run_lanes`.
+        width: batch slots per device of the pool (default `DEFAULT_WIDTH`).
         devices: devices to shard each chunk over (default all local devices).
         out: directory; write the dataset chunk by chunk there and resume a previous,
             interrupted run of the same sweep (`jaxcelt.dataset`).
@@ -370,7 +721,10 @@ def sweep(
         solver=solver if solver is not None else DEFAULT_SOLVER,
         contact_law=contact_law,
         t0=float(t0),
+        stop_on_invalid=bool(stop_on_invalid),
     )
+    if scheduler not in SCHEDULERS:
+        raise ValueError(f"scheduler must be one of {SCHEDULERS}, got {scheduler!r}")
     values = np.atleast_1d(np.asarray(values, dtype=np.float64))
     if values.ndim != 1 or values.size == 0:
         raise ValueError(f"values must be a non-empty 1-D array, got shape {values.shape}")
@@ -389,7 +743,7 @@ def sweep(
         raise ValueError("stroboscopic sampling needs omega_pi > 0 in every lane")
     order = np.arange(L)
     if sort_by_cost:
-        order = np.argsort(1.0 / np.asarray(pb_all.omega_pi), kind="stable")
+        order = np.argsort(np.asarray(pb_all.omega_pi), kind="stable")  # longest period first
     cs = L if chunk_size is None else max(1, int(chunk_size))
     chunks = [order[i : i + cs] for i in range(0, L, cs)]
 
@@ -421,7 +775,7 @@ def sweep(
             continue
         pb = jax.tree_util.tree_map(lambda x, idx=idx: np.asarray(x)[idx], pb_all)
         t_start = time.perf_counter()
-        res = run_lanes(pb, lane_y0[idx], cfg, devices=devices, pad_to=cs)
+        res = run_lanes(pb, lane_y0[idx], cfg, devices=devices, pad_to=cs, scheduler=scheduler, width=width)
         res["_seconds"] = np.full(len(idx), (time.perf_counter() - t_start) / len(idx))
         results[ci] = res
         if writer is not None:

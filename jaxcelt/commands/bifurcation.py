@@ -37,7 +37,17 @@ def register(sub) -> None:
     p.add_argument("--rtol", type=float, default=1e-8)
     p.add_argument("--atol", type=float, default=1e-10)
     p.add_argument("--max-steps", type=int, default=1_000_000)
-    p.add_argument("--chunk-size", type=int, default=32, help="lanes per jitted vmapped solve")
+    p.add_argument(
+        "--chunk-size", type=int, default=100, help="lanes per jitted pool launch (the unit of resumable writing)"
+    )
+    p.add_argument("--width", type=int, default=16, help="pool slots: lanes stepped side by side (vmap width)")
+    p.add_argument(
+        "--stop-on-invalid",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="end a lane at its first invalid state (lift-off or n3 <= 0; the model does not hold past it): "
+        "label 'invalid', later samples inf, no Lyapunov exponent. --no-stop-on-invalid integrates on",
+    )
     p.add_argument("--orbits", default="14,15.6,17,19", help="omega_pi values for phase-plot figures ('' for none)")
     p.add_argument("--orbit-periods", type=int, default=40, help="periods shown in the phase plots")
     p.add_argument("--out", type=Path, default=Path("out/bifurcation"), help="output directory (resumable)")
@@ -101,6 +111,8 @@ def run(args) -> int:
         atol=args.atol,
         max_steps=args.max_steps,
         chunk_size=args.chunk_size,
+        width=args.width,
+        stop_on_invalid=args.stop_on_invalid,
         sort_by_cost=True,
         out=str(args.out),
         progress=True,
@@ -116,6 +128,7 @@ def run(args) -> int:
         "lyapunov_periods": args.lyapunov,
         "rtol": args.rtol,
         "atol": args.atol,
+        "stop_on_invalid": bool(args.stop_on_invalid),
         "wall_seconds_including_compile": round(wall, 2),
         "lanes_failed": int(np.sum(ds["status"].values != 0)),
         "lanes_invalid": int(np.sum(ds["valid"].values == 0)),
