@@ -7,8 +7,9 @@ unbounded global wandering" at omega_pi = 15.6 rad/s).
 Local label, from the section samples x_j = (omega, n)(t_j) (state components 3:9, which
 with psi determine the dynamics; r_C does not feed back):
 
-* ``failed``   -- the solve did not finish (status != 0, e.g. max_steps);
-* ``invalid``  -- the model left its validity (lift-off, n3 <= 0) somewhere in the run;
+* ``failed``   -- the solve did not finish (status 1 or 3, e.g. max_steps);
+* ``invalid``  -- the model left its validity (lift-off, n3 <= 0) somewhere in the run, or the
+  lane was stopped there (status 2, ``stop_on_invalid``);
 * ``period-k`` -- smallest k <= ``max_period`` with max_j |x_{j+k} - x_j| <= tol (1 + max|x|)
   over the samples; k = 1 is the forcing period (a period-1 orbit of the stroboscopic map);
 * otherwise ``chaotic`` if the largest Lyapunov exponent exceeds ``chaos_threshold`` [1/s],
@@ -89,6 +90,9 @@ def classify(
     period = np.zeros(flat.shape[0], dtype=np.int32)
     glob = np.full(flat.shape[0], -1, dtype=np.int32)
     for i in range(flat.shape[0]):
+        if st[i] == 2:  # stopped at its first invalid state (stop_on_invalid)
+            regime[i] = 1
+            continue
         if st[i] != 0:
             regime[i] = 0
             continue

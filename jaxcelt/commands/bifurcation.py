@@ -38,7 +38,7 @@ def register(sub) -> None:
     p.add_argument("--atol", type=float, default=1e-10)
     p.add_argument("--max-steps", type=int, default=1_000_000)
     p.add_argument(
-        "--chunk-size", type=int, default=100, help="lanes per jitted pool launch (the unit of resumable writing)"
+        "--chunk-size", type=int, default=32, help="lanes per jitted pool launch (the unit of resumable writing)"
     )
     p.add_argument("--width", type=int, default=16, help="pool slots: lanes stepped side by side (vmap width)")
     p.add_argument(
