@@ -76,18 +76,27 @@ def plot_loss_histories(results, labels: Sequence[str]):
 
 
 def plot_parameter_traces(results, labels: Sequence[str], *, true=None):
-    """Each free parameter against the iteration, one panel per parameter, one line per fit."""
+    """Each free parameter against the iteration, one panel per parameter, one line per fit.
+
+    With ``true``: the ratio fitted/true on a log axis clipped to [1/20, 20] (a diverging fit
+    leaves the panel at the top or bottom edge instead of flattening the others)."""
     import matplotlib.pyplot as plt
 
     free = results[0].free
-    fig, ax = plt.subplots(1, len(free), figsize=(3.3 * len(free), 3.3), constrained_layout=True)
+    fig, ax = plt.subplots(1, len(free), figsize=(3.4 * len(free), 3.4), constrained_layout=True)
+    n_max = max(len(r.param_history) for r in results)
     for j, n in enumerate(free):
         a = np.atleast_1d(ax)[j]
+        t = _val(true, n)
         for r, lab in zip(results, labels):
-            a.plot([h[n] for h in r.param_history], label=lab, lw=1.1)
-        if true is not None:
-            a.axhline(_val(true, n), color="k", ls="--", lw=0.8, label="true")
-        a.set(xlabel="iteration", title=n, xscale="symlog")
+            v = np.asarray([h[n] for h in r.param_history], float)
+            if t is not None:
+                v = np.clip(np.nan_to_num(v / t, nan=20.0, posinf=20.0), 1 / 20, 20)
+            a.plot(np.arange(1, len(v) + 1), v, label=lab, lw=1.2)
+        if t is not None:
+            a.axhline(1.0, color="k", ls="--", lw=0.8, label="true")
+            a.set(yscale="log", ylim=(1 / 22, 22), ylabel="fitted / true" if j == 0 else None)
+        a.set(xlabel="iteration + 1", title=n, xscale="log", xlim=(1, n_max))
         if j == 0:
             a.legend(fontsize=8)
     return fig
