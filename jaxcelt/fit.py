@@ -713,7 +713,12 @@ def fit(
         dof = max(n_data - (n_unk - 3 * sum(len(rec.free_windows) for rec in prob.records)), 1)
         s2 = misfit / dof
         H = Jflat.T @ Jflat
-        cov_z = s2 * np.linalg.pinv(H, rcond=1e-13, hermitian=True)[:P, :P]
+        try:  # a fit that ended in a failing-solve region can leave a non-finite Jacobian
+            if not np.all(np.isfinite(H)):
+                raise np.linalg.LinAlgError("non-finite Gauss-Newton matrix")
+            cov_z = s2 * np.linalg.pinv(H, rcond=1e-13, hermitian=True)[:P, :P]
+        except np.linalg.LinAlgError:
+            cov_z = np.full((P, P), np.nan)
         dth = np.asarray(jax.jacfwd(prob.theta)(z["params"]))
         cov = dth @ cov_z @ dth.T
         se = np.sqrt(np.maximum(np.diag(cov), 0.0))

@@ -211,7 +211,7 @@ def chaos_single(out):
 
 def chaos_single_damped(out):
     _chaos_fit(
-        out, "single shooting, damped GN", "single_gnd", optimiser="gn-damped", windows=1, max_iter=20, max_time=480.0
+        out, "single shooting, damped GN", "single_gnd", optimiser="gn-damped", windows=1, max_iter=20, max_time=300.0
     )
 
 
