@@ -211,9 +211,18 @@ def run_ladder(
 
 def recommend(results: list[RungResult], tol: float) -> str:
     """Cheapest rung (run wall time) with error <= tol, a successful solve and a valid model;
-    the reference (first rung) if none qualifies."""
-    ok = [r for r in results[1:] if r.error <= tol and r.status == 0 and r.valid]
-    return min(ok, key=lambda r: r.run_s).rung if ok else results[0].rung
+    the reference (first rung) if none qualifies.
+
+    Wall times of laws with the same step count differ only by timing noise, so rungs within
+    25 % of the fastest are treated as a tie, broken by fewer accepted steps, then by ladder
+    order (the simpler law comes later in the default ladder, so prefer the later one).
+    """
+    ok = [(i, r) for i, r in enumerate(results) if i > 0 and r.error <= tol and r.status == 0 and r.valid]
+    if not ok:
+        return results[0].rung
+    fastest = min(r.run_s for _, r in ok)
+    near = [(i, r) for i, r in ok if r.run_s <= 1.25 * fastest]
+    return min(near, key=lambda ir: (ir[1].steps, -ir[0]))[1].rung
 
 
 def needed_state(scene: Scene, law: AbstractContactLaw | str | None = None, n_points: int = 5) -> dict:

@@ -46,3 +46,12 @@ def test_needed_state():
     assert "psi" in fixed["droppable"] and "rC1" in fixed["droppable"]
     moving = needed_state(sc["base14"])
     assert "psi" in moving["needed"] and "rC1" in moving["droppable"]
+
+
+def test_recommend_breaks_timing_ties_by_steps():
+    # run times within 25 % are timing noise: the rung with fewer accepted steps wins
+    a = RungResult("a", 0.01, {}, 0.100, 1.0, 500, 0, True)
+    b = RungResult("b", 0.01, {}, 0.110, 1.0, 300, 0, True)
+    c = RungResult("c", 0.01, {}, 0.300, 1.0, 100, 0, True)  # fewer steps but clearly slower
+    ref = RungResult("integral", 0.0, {}, 5.0, 10.0, 300, 0, True)
+    assert recommend([ref, a, b, c], 0.05) == "b"
