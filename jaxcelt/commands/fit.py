@@ -30,7 +30,7 @@ def register(sub) -> None:
     p.add_argument(
         "--kinds", nargs="+", default=None, help="use only these observation kinds (state omega orientation centre)"
     )
-    p.add_argument("--optimiser", choices=("lm", "gn", "adam", "lbfgs"), default="lm")
+    p.add_argument("--optimiser", choices=("lm", "gn", "gn-damped", "adam", "lbfgs"), default="lm")
     p.add_argument("--windows", type=int, default=1, help="multiple-shooting windows per record (1 = single shooting)")
     p.add_argument("--window-states", choices=("optimise", "data"), default="optimise")
     p.add_argument("--fit-y0", action="store_true", help="also optimise the first initial state")
