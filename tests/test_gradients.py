@@ -115,11 +115,16 @@ def test_gradient_from_exact_rest_is_finite():
 
 @pytest.mark.slow
 def test_plain_grad_equals_vmapped_lane(batch):
-    """The unbatched jax.grad gives the same numbers as the vmapped lane (1e-10 relative)."""
+    """The unbatched jax.grad gives the same numbers as the vmapped lane (1e-10 relative to the gradient).
+
+    vmap reorders floating-point operations, so each component carries round-off of the order of the
+    largest component: components ~1e6 times smaller than the largest (measured: 1.65e-5 next to 15.1)
+    can differ by 4.5e-10 relative (7e-15 absolute). Tolerance: 1e-10 of the gradient's max norm.
+    """
     thetas, y0s, _, grads = batch
     for i in range(2):
         g = np.asarray(jax.jit(jax.grad(_loss))(jnp.asarray(thetas[i]), jnp.asarray(y0s[i])))
-        np.testing.assert_allclose(g, grads[i], rtol=1e-10)
+        np.testing.assert_allclose(g, grads[i], rtol=1e-10, atol=1e-10 * np.max(np.abs(grads[i])))
 
 
 @pytest.mark.slow
