@@ -35,7 +35,7 @@ from . import _config  # noqa: F401
 from ._types import Array, ArrayLike, Scalar, ScalarLike, Vec3
 from .model import contact_geometry, horizontal_frame
 from .params import CeltParams
-from .solve import Solution, Validity
+from .solve import Solution, Validity, status_code
 
 __all__ = [
     "NOSLIP_STATE_NAMES",
@@ -149,8 +149,7 @@ def _solve_noslip(p, z0, t0, t1, ts, rtol, atol, *, solver, max_steps):
         min_N=jnp.min(N),
         max_tilt=jnp.max(jnp.arccos(jnp.clip(n3, -1, 1))),
     )
-    R = diffrax.RESULTS
-    status = jnp.where(sol.result == R.successful, 0, jnp.where(sol.result == R.max_steps_reached, 1, 3))
+    status = status_code(sol.result)  # no event here, so never 2
     return Solution(
         ts=sol.ts,
         ys=ys,

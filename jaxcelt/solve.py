@@ -175,6 +175,16 @@ class Solution(eqx.Module):
 DEFAULT_SOLVER = diffrax.Tsit5()
 
 
+def status_code(result) -> Array:
+    """`STATUS` code of a diffrax result: 0 success, 1 max_steps, 2 event (stopped invalid), 3 other."""
+    R = diffrax.RESULTS
+    return jnp.where(
+        result == R.successful,
+        0,
+        jnp.where(result == R.max_steps_reached, 1, jnp.where(result == R.event_occurred, 2, 3)),
+    ).astype(jnp.int32)
+
+
 class _Field(eqx.Module):
     law: AbstractContactLaw
 
@@ -251,12 +261,7 @@ def _solve(
         throw=False,
         progress_meter=diffrax.TqdmProgressMeter() if progress else diffrax.NoProgressMeter(),
     )
-    R = diffrax.RESULTS
-    status = jnp.where(
-        sol.result == R.successful,
-        0,
-        jnp.where(sol.result == R.max_steps_reached, 1, jnp.where(sol.result == R.event_occurred, 2, 3)),
-    )
+    status = status_code(sol.result)
     _, mon = sol.solver_state
     return Solution(
         ts=sol.ts,

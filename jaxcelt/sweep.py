@@ -75,7 +75,7 @@ from .contact import AbstractContactLaw, get_contact_law
 from .diagnostics import centre_position
 from .lyapunov import celt_lyapunov
 from .params import PARAM_NAMES, CeltParams
-from .solve import DEFAULT_SOLVER, MonitoredSolver, _Field, _fill_implicit_tols, simulate
+from .solve import DEFAULT_SOLVER, MonitoredSolver, _Field, _fill_implicit_tols, simulate, status_code
 from .state import initial_state
 
 __all__ = [
@@ -389,14 +389,9 @@ def _lane_step(cfg: SweepConfig, st: dict[str, Any]) -> tuple[dict[str, Any], Ar
 
 
 def _lane_status(st: dict[str, Any]) -> Array:
-    R = diffrax.RESULTS
-    res = st["result"]
-    ok = res == R.successful
-    return jnp.where(
-        ok & (st["tprev"] >= st["t1"]),
-        0,
-        jnp.where(ok, 1, jnp.where(res == R.max_steps_reached, 1, jnp.where(res == R.event_occurred, 2, 3))),
-    ).astype(jnp.int32)
+    # a lane that is still "successful" but has not reached t1 ran out of steps: status 1
+    ok = st["result"] == diffrax.RESULTS.successful
+    return jnp.where(ok, jnp.where(st["tprev"] >= st["t1"], 0, 1), status_code(st["result"])).astype(jnp.int32)
 
 
 def _pool(
