@@ -2,18 +2,26 @@
 apart) and against right-hand-side evaluations, for diffrax explicit, implicit and fixed-step
 methods over tolerance / dt ladders; float64 and float32; every contact law in jc.CONTACT_LAWS.
 
-Reference per scene: diffrax Dopri8 at rtol = atol = 1e-13 (validated against scipy DOP853 on an
-independent numba RHS by ``benchmarks/reference.py``). Error: max |y - y_ref| over the sample
-times and the 13 state components (SI units). RHS evaluations: exact count for implicit methods
-(counting contact law, Jacobian columns included), steps x stages for explicit ones.
+Reference per scene (and per contact law): diffrax Dopri8 at rtol = atol = 1e-13 (validated
+against scipy DOP853 on an independent numba RHS by ``benchmarks/reference.py``). Error: max
+|y - y_ref| over the sample times and the 13 state components (SI units). RHS evaluations: exact
+count for implicit methods (counting contact law, Jacobian columns included), steps x stages for
+explicit and fixed-step ones.
 
-    python benchmarks/work_precision.py [--quick] [--out docs/performance] [--parts scenes,float32,laws]
+Incremental and resumable: the JSON is rewritten after every ladder (one method on one scene),
+ladders already in the JSON are skipped on a re-run, each ladder stops at a wall-time budget
+(compile included) or at the first run slower than ``max_run_s`` or failing, and ``--deadline-min``
+stops starting new ladders after that many minutes.
+
+    python benchmarks/work_precision.py [--quick] [--out docs/performance]
+        [--parts scenes,float32,laws] [--deadline-min 60] [--fresh]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import pathlib
 import time
 
@@ -25,11 +33,12 @@ from jaxcelt import benchmarking as bm
 from jaxcelt.versions import versions
 
 EXPLICIT = ["Tsit5", "Dopri5", "Dopri8"]
-IMPLICIT = ["Kvaerno3", "Kvaerno5", "Kvaerno3-Newton", "Kvaerno5-Newton"]
+IMPLICIT = ["Kvaerno3-Newton", "Kvaerno5-Newton"]
 FIXED = ["RK4-fixed", "Heun-fixed"]
 
 
-def _stages_per_step(name: str) -> int | None:
+def _stages_per_step(name: str) -> int:
+    """RHS evaluations per step (accepted or rejected) of an explicit / fixed-step method."""
     s = bm.make_solver(name)
     s = getattr(s, "solver", s)
     tab = getattr(s, "tableau", None)
@@ -38,21 +47,33 @@ def _stages_per_step(name: str) -> int | None:
     return tab.num_stages - (1 if tab.fsal and bm.SOLVERS[name][1] != "fixed" else 0)
 
 
-def reference_ys(scene: bm.Scene, law=None) -> np.ndarray:
+def reference_ys(scene: bm.Scene, law=None) -> tuple[np.ndarray, dict]:
+    t = time.perf_counter()
     sol = jc.simulate(
         scene.params, scene.y0, scene.t1, ts=scene.ts, solver=bm.make_solver("Dopri8"), rtol=1e-13, atol=1e-13,
         exact_ts=True, contact_law=law, max_steps=2_000_000,
     )  # fmt: skip
-    return np.asarray(jax.block_until_ready(sol.ys))
+    ys = np.asarray(jax.block_until_ready(sol.ys))
+    info = dict(steps=int(sol.num_steps), status=int(sol.status), seconds=time.perf_counter() - t)
+    return ys, info
 
 
-def ladder(scene, name, values, *, ys_ref, law=None, dtype=None, max_run_s=20.0, count_implicit=True, repeats=2):
-    """Run one method down its ladder; stop when a run exceeds ``max_run_s`` or fails."""
+def ladder(scene, name, values, *, ys_ref, law=None, dtype=None, max_run_s=10.0, budget_s=240.0, repeats=2):
+    """Run one method down its ladder.
+
+    Stops at the first failed run, at a run slower than ``max_run_s``, or when the ladder has
+    used ``budget_s`` of wall time (compile included). Repeats drop to 1 for runs over 2 s.
+    """
     out = []
     kind = bm.SOLVERS[name][1]
+    t_ladder = time.perf_counter()
+    count = kind == "implicit"
     for v in values:
+        if time.perf_counter() - t_ladder > budget_s:
+            print(f"  {name}: ladder budget {budget_s:.0f} s used, stopping before {v:g}", flush=True)
+            out.append(dict(scene=scene.name, solver=name, kind=kind, skipped=f"ladder budget {budget_s:.0f} s"))
+            break
         kw = dict(dt0=v) if kind == "fixed" else dict(rtol=v)
-        count = count_implicit and kind == "implicit"
         try:
             r = bm.run_diffrax(
                 scene, name, ys_ref=ys_ref, law=law, dtype=dtype, repeats=repeats, count_evals=count, **kw
@@ -62,14 +83,22 @@ def ladder(scene, name, values, *, ys_ref, law=None, dtype=None, max_run_s=20.0,
             out.append(dict(scene=scene.name, solver=name, kind=kind, error_message=str(e)[:500], **kw))
             break
         if "rhs_evals" not in r:
-            r["rhs_evals"] = None if kind == "implicit" else r["steps"] * _stages_per_step(name)
+            r["rhs_evals"] = r["steps"] * _stages_per_step(name) + 1
+            r["rhs_evals_how"] = "steps x stages + 1"
+        else:
+            r["rhs_evals_how"] = "counted"
+        r["loadavg_1min"] = os.getloadavg()[0]
+        r.pop("final_state", None)
         out.append(r)
         print(
             f"  {name:16s} {r['dtype']:8s} {str(kw):22s} err {r['error']:.2e}  run {r['run_s'] * 1e3:8.1f} ms  "
-            f"compile {r['compile_s']:5.1f} s  steps {r['accepted']}+{r['rejected']}  nfe {r['rhs_evals']}  status {r['status']}",
+            f"compile {r['compile_s']:5.1f} s  steps {r['accepted']}+{r['rejected']}  nfe {r['rhs_evals']}  "
+            f"status {r['status']}  load {r['loadavg_1min']:.1f}",
             flush=True,
         )
-        if r["status"] != 0 or r["run_s"] > max_run_s:
+        if r["run_s"] > 2.0:
+            repeats = 1
+        if r["status"] != 0 or not np.isfinite(r["error"]) or r["run_s"] > max_run_s:
             break
     return out
 
@@ -83,32 +112,36 @@ def config(quick: bool):
             dts=[2e-3, 5e-4],
             explicit=["Tsit5", "Dopri8"],
             implicit=["Kvaerno5-Newton"],
+            chord=[],
             fixed=["RK4-fixed"],
+            f32_scenes=["rest17"],
             f32_rtols=[1e-3, 1e-5],
             f32_solvers=["Tsit5"],
             laws=["generalised_pade", "pade"],
+            law_solvers=["Tsit5"],
             max_run_s=5.0,
+            budget_s=120.0,
             repeats=1,
         )
     return dict(
-        scenes=[("rest17", 5), ("stick_slip", 1), ("rest19", 5), ("spin_reversal", 5)],
-        rtols=[1e-4, 1e-6, 1e-8, 1e-10, 1e-12],  # a ladder stops early past max_run_s
-        rtols_implicit=[1e-4, 1e-6, 1e-8, 1e-10],
-        dts=[4e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4],
+        scenes=[("rest17", 5), ("stick_slip", 1), ("rest19", 5), ("rest14", 5), ("spin_reversal", 5)],
+        rtols=[1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12],
+        rtols_implicit=[1e-4, 1e-6, 1e-8],
+        dts=[4e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4, 5e-5],
         explicit=EXPLICIT,
-        implicit=["Kvaerno5", "Kvaerno3-Newton", "Kvaerno5-Newton"],
+        implicit=IMPLICIT,
+        chord=dict(scenes=["rest17", "stick_slip"], solver="Kvaerno5", rtols=[1e-4, 1e-6]),
         fixed=FIXED,
-        f32_rtols=[1e-2, 1e-3, 1e-4, 1e-5, 1e-6],
-        f32_solvers=["Tsit5", "Dopri5"],
-        laws=[k for k in jc.CONTACT_LAWS],
-        max_run_s=20.0,
+        f32_scenes=["rest17", "stick_slip"],
+        f32_rtols=[1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8],
+        f32_solvers=["Tsit5", "Dopri8"],
+        laws=list(jc.CONTACT_LAWS),
+        law_solvers=["Tsit5", "Dopri8"],
+        law_rtols=[1e-4, 1e-6, 1e-8, 1e-10, 1e-12],
+        max_run_s=10.0,
+        budget_s=300.0,
         repeats=2,
     )
-
-
-def _save(res, out, quick):
-    # written after every part so that an interrupted long run keeps what it measured
-    (out / f"work_precision{'_quick' if quick else ''}.json").write_text(json.dumps(res, indent=1))
 
 
 def main(argv=None):
@@ -116,88 +149,122 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--out", default="docs/performance")
     ap.add_argument("--parts", default="scenes,float32,laws")
+    ap.add_argument("--deadline-min", type=float, default=1e9, help="start no new ladder after this many minutes")
+    ap.add_argument("--fresh", action="store_true", help="ignore an existing JSON (default: resume)")
+    ap.add_argument("--plot-only", action="store_true")
     args = ap.parse_args(argv)
     cfg = config(args.quick)
-    parts = set(args.parts.split(","))
+    parts = args.parts.split(",")
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    tag = "_quick" if args.quick else ""
+    path = out / f"work_precision{tag}.json"
     info = versions()
     info["device"] = bm.device_string()
     print("versions:", info, flush=True)
-    res: dict = dict(versions=info, config={k: v for k, v in cfg.items()}, scenes=[], float32=[], laws=[])
+    if path.exists() and not args.fresh:
+        res = json.loads(path.read_text())
+        print(f"resuming {path}: {len(res.get('done', []))} ladders done", flush=True)
+    else:
+        res = dict(scenes=[], float32=[], laws=[], done=[], references={})
+    res["config"] = {k: v for k, v in cfg.items()}
+    res.setdefault("sessions", []).append(
+        dict(versions=info, started=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()))
+    )
+    res["versions"] = info
     t_start = time.perf_counter()
-    if "scenes" in parts:
-        for name, periods in cfg["scenes"]:
-            sc = bm.make_scene(name, periods)
-            ref = reference_ys(sc)
-            print(f"scene {name} ({sc.description})", flush=True)
-            runs = []
-            for s in cfg["explicit"]:
-                runs += ladder(sc, s, cfg["rtols"], ys_ref=ref, max_run_s=cfg["max_run_s"], repeats=cfg["repeats"])
-            for s in cfg["implicit"]:
-                runs += ladder(
-                    sc, s, cfg["rtols_implicit"], ys_ref=ref, max_run_s=cfg["max_run_s"], repeats=cfg["repeats"]
-                )
-            for s in cfg["fixed"]:
-                runs += ladder(sc, s, cfg["dts"], ys_ref=ref, max_run_s=cfg["max_run_s"], repeats=cfg["repeats"])
-            res["scenes"].append(dict(scene=name, description=sc.description, periods=periods, runs=runs))
-            _save(res, out, args.quick)
-    if "float32" in parts:
-        sc = bm.make_scene("rest17", cfg["scenes"][0][1])
-        ref = reference_ys(sc)
-        print("float32 vs float64 on", sc.description, flush=True)
-        runs = []
-        for s in cfg["f32_solvers"]:
-            runs += ladder(
-                sc,
-                s,
-                cfg["f32_rtols"],
-                ys_ref=ref,
-                dtype=np.float32,
-                max_run_s=cfg["max_run_s"],
-                count_implicit=False,
-                repeats=cfg["repeats"],
-            )
-        runs += ladder(
-            sc,
-            cfg["fixed"][0],
-            cfg["dts"][:3],
-            ys_ref=ref,
-            dtype=np.float32,
-            max_run_s=cfg["max_run_s"],
-            repeats=cfg["repeats"],
-        )
-        res["float32"] = runs
-        _save(res, out, args.quick)
-    if "laws" in parts:
-        sc = bm.make_scene("rest17", cfg["scenes"][0][1])
-        for law in cfg["laws"]:
-            print(f"contact law {law}", flush=True)
-            try:
-                ref = reference_ys(sc, law=law)
-            except Exception as e:
-                print("  reference failed:", e)
-                continue
-            runs = ladder(
-                sc, "Tsit5", cfg["rtols"][:4], ys_ref=ref, law=law, max_run_s=cfg["max_run_s"], repeats=cfg["repeats"]
-            )
-            runs += ladder(
-                sc,
-                "Kvaerno5-Newton",
-                cfg["rtols_implicit"][:3],
-                ys_ref=ref,
-                law=law,
-                max_run_s=cfg["max_run_s"],
-                count_implicit=False,
-                repeats=cfg["repeats"],
-            )
-            res["laws"].append(dict(law=law, runs=runs))
-            _save(res, out, args.quick)
-    res["total_seconds"] = time.perf_counter() - t_start
-    tag = "_quick" if args.quick else ""
-    path = out / f"work_precision{tag}.json"
-    path.write_text(json.dumps(res, indent=1))
-    print("wrote", path, f"({res['total_seconds']:.0f} s)")
+    refs: dict = {}
+
+    def save():
+        path.write_text(json.dumps(res, indent=1))
+
+    def out_of_time():
+        return (time.perf_counter() - t_start) / 60 > args.deadline_min
+
+    def get_ref(scene_name, periods, law=None):
+        key = f"{scene_name}/{periods}/{law}"
+        if key not in refs:
+            sc = bm.make_scene(scene_name, periods)
+            ys, rinfo = reference_ys(sc, law)
+            print(f"reference {key}: {rinfo}", flush=True)
+            res["references"][key] = rinfo
+            refs[key] = (sc, ys)
+        return refs[key]
+
+    def entry(lst, key, val, **extra):
+        for e in lst:
+            if e[key] == val:
+                return e
+        e = {key: val, **extra, "runs": []}
+        lst.append(e)
+        return e
+
+    def run_ladder(lkey, lst, key, val, extra, scene_name, periods, solver, values, law=None, dtype=None):
+        if lkey in res["done"] or args.plot_only:
+            return
+        if out_of_time():
+            print(f"deadline: skipping {lkey}", flush=True)
+            return
+        sc, ys_ref = get_ref(scene_name, periods, law)
+        e = entry(lst, key, val, description=sc.description, periods=periods, **extra)
+        print(f"[{lkey}] {sc.description}", flush=True)
+        t = time.perf_counter()
+        runs = ladder(
+            sc, solver, values, ys_ref=ys_ref, law=law, dtype=dtype, max_run_s=cfg["max_run_s"],
+            budget_s=cfg["budget_s"], repeats=cfg["repeats"],
+        )  # fmt: skip
+        for r in runs:
+            r["law_name"] = law or "generalised_pade"
+        e["runs"] = [r for r in e["runs"] if not (r["solver"] == solver and r.get("dtype", "float64") == (
+            "float32" if dtype is np.float32 else "float64"))] + runs  # fmt: skip
+        res["done"].append(lkey)
+        res.setdefault("ladder_seconds", {})[lkey] = time.perf_counter() - t
+        save()
+
+    for part in parts:
+        if part == "scenes":
+            for name, periods in cfg["scenes"]:
+                for s in cfg["explicit"]:
+                    run_ladder(f"scenes/{name}/{s}", res["scenes"], "scene", name, {}, name, periods, s, cfg["rtols"])
+                for s in cfg["implicit"]:
+                    run_ladder(
+                        f"scenes/{name}/{s}", res["scenes"], "scene", name, {}, name, periods, s, cfg["rtols_implicit"]
+                    )
+                for s in cfg["fixed"]:
+                    run_ladder(f"scenes/{name}/{s}", res["scenes"], "scene", name, {}, name, periods, s, cfg["dts"])
+                ch = cfg["chord"]
+                if ch and name in ch["scenes"]:
+                    run_ladder(
+                        f"scenes/{name}/{ch['solver']}", res["scenes"], "scene", name, {}, name, periods,
+                        ch["solver"], ch["rtols"],
+                    )  # fmt: skip
+        elif part == "float32":
+            periods = dict(cfg["scenes"])
+            for name in cfg["f32_scenes"]:
+                for s in cfg["f32_solvers"]:
+                    run_ladder(
+                        f"float32/{name}/{s}", res["float32"], "scene", name, {}, name, periods[name], s,
+                        cfg["f32_rtols"], dtype=np.float32,
+                    )  # fmt: skip
+        elif part == "laws":
+            name, periods = "rest17", dict(cfg["scenes"])["rest17"]
+            for law in cfg["laws"]:
+                for s in cfg["law_solvers"]:
+                    try:
+                        run_ladder(
+                            f"laws/{law}/{s}", res["laws"], "law", law, dict(scene=name), name, periods, s,
+                            cfg.get("law_rtols", cfg["rtols"]), law=law,
+                        )  # fmt: skip
+                    except Exception as ex:  # e.g. a reference that does not finish
+                        print(f"  law {law}: {type(ex).__name__}: {ex}", flush=True)
+                        entry(res["laws"], "law", law, scene=name)["error_message"] = str(ex)[:500]
+                        save()
+                        break
+        else:
+            raise ValueError(f"unknown part {part!r}")
+    res["total_seconds_last_session"] = time.perf_counter() - t_start
+    save()
+    print("wrote", path, f"({res['total_seconds_last_session']:.0f} s)", flush=True)
     from jaxcelt.plotting.performance import plot_work_precision
 
     for fig_name, fig in plot_work_precision(res).items():
