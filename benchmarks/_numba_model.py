@@ -1,10 +1,15 @@
-"""A hand-written numba copy of the wobblestone right-hand side (MODEL.md sections 3-8) and an
-adaptive Dormand-Prince 5(4) ensemble integrator -- the CPU baselines of ``bench_sweep.py``.
+"""The one hand-written port of the wobblestone right-hand side (MODEL.md sections 3-8) and an
+adaptive Dormand-Prince 5(4) ensemble integrator -- the CPU baselines of ``bench_sweep.py``,
+``peers.py`` and the independent reference of ``reference.py``.
 
 Written independently of the JAX code from MODEL.md (same equations, same default readings);
-checked against `jaxcelt.vector_field` in the benchmark itself (and in its accuracy check).
+checked against `jaxcelt.vector_field` by `check_against_jax` (tests/test_benchmarks_smoke.py).
 Parameter vector layout: see `pack`. K, E, G, H and B^-1 are precomputed (as a hand-written
 code would), so one RHS here is the irreducible arithmetic.
+
+Three ways to call the same source: `rhs` (numba, allocation-free, for numba loops and CVODE),
+`numba_rhs(p)` (an ``f(t, y)`` for scipy), `python_rhs(p)` (the same Python source run by the
+interpreter, no compilation: the "plain Python/NumPy RHS" peer).
 """
 
 from __future__ import annotations
@@ -239,3 +244,82 @@ def rhs_loop(y, P, B, Bi, n):
         rhs(0.1 + i * 1e-9, y, P, B, Bi, out)
         acc += out[3]
     return acc
+
+
+# --------------------------------------------------------------------------------------------
+# f(t, y) wrappers for scipy, and the agreement check against jaxcelt
+
+
+def numba_rhs(p):
+    """``f(t, y) -> dy/dt`` (a fresh array per call, as scipy expects) over the compiled `rhs`."""
+    P, B, Bi = pack(p)
+
+    def f(t, y):
+        out = np.empty(13)
+        rhs(float(t), np.ascontiguousarray(y, dtype=np.float64), P, B, Bi, out)
+        return out
+
+    return f
+
+
+def _interpreted(fn, **globals_):
+    import types
+
+    g = dict(fn.py_func.__globals__)
+    g.update(globals_)
+    return types.FunctionType(fn.py_func.__code__, g, fn.py_func.__name__ + "_py")
+
+
+_rhs_py = _interpreted(rhs, _cross=_cross.py_func)
+
+
+def python_rhs(p):
+    """``f(t, y) -> dy/dt``: the source of `rhs` run by the Python interpreter (nothing compiled)."""
+    P, B, Bi = pack(p)
+
+    def f(t, y):
+        out = np.empty(13)
+        _rhs_py(float(t), np.asarray(y, dtype=np.float64), P, B, Bi, out)
+        return out
+
+    return f
+
+
+def ensemble(Y0, ts, p, rtol, atol, max_steps=10**7):
+    """`dopri_ensemble` for one parameter set and common sample times ``ts`` (ts[0] = 0 = start time).
+
+    Returns (ys (L, len(ts), 13) with ys[:, 0] = Y0, steps (L,), evals (L,), status (L,)).
+    """
+    P, B, Bi = pack(p)
+    Y0 = np.ascontiguousarray(Y0, dtype=np.float64)
+    L = Y0.shape[0]
+    ts = np.asarray(ts, dtype=np.float64)
+    if ts[0] != 0.0:
+        raise ValueError(f"ts[0] must be 0 (the start time), got {ts[0]}")
+    TS = np.ascontiguousarray(np.broadcast_to(ts[1:], (L, ts.size - 1)))
+    PP = np.ascontiguousarray(np.broadcast_to(P, (L, NP)))
+    ys, steps, evals, status = dopri_ensemble(Y0, TS, PP, B, Bi, rtol, atol, max_steps)
+    return np.concatenate([Y0[:, None], ys], axis=1), steps, evals, status
+
+
+def check_against_jax(p, n_samples: int = 20, seed: int = 0, interpreted: bool = False) -> float:
+    """Max relative difference (max-abs over the 13 components / max |f_jax|) between this port and
+    `jaxcelt.vector_field` at random tilted, spinning, sliding states and random times."""
+    import jaxcelt as jc
+
+    rng = np.random.default_rng(seed)
+    f = python_rhs(p) if interpreted else numba_rhs(p)
+    worst = 0.0
+    for _ in range(n_samples):
+        n = rng.normal(size=3) * np.array([0.2, 0.2, 0.0]) + np.array([0, 0, 1.0])
+        n /= np.linalg.norm(n)
+        y = np.asarray(
+            jc.initial_state(
+                p, omega=rng.normal(size=3) * 3, n=n, psi=rng.uniform(0, 6), v_A=np.cross(n, rng.normal(size=3)) * 0.1
+            )
+        )
+        t = rng.uniform(0, 2)
+        a = f(t, y)
+        b = np.asarray(jc.vector_field(t, y, p))
+        worst = max(worst, float(np.max(np.abs(a - b)) / (np.max(np.abs(b)) + 1e-300)))
+    return worst

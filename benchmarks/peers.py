@@ -2,7 +2,7 @@
 
 Single trajectory (scene rest17 from rest, error at the stroboscopic samples against the Dopri8
 1e-13 reference): jaxcelt (diffrax Tsit5 / Kvaerno5-Newton, jit-compiled), scipy solve_ivp
-DOP853 / LSODA / Radau with a plain NumPy RHS and with a numba RHS (``benchmarks/_peers.py``), a
+DOP853 / LSODA / Radau with a plain NumPy RHS and with a numba RHS (``benchmarks/_numba_model.py``), a
 hand-written numba adaptive Dormand-Prince ensemble, and SUNDIALS CVODE (scikit-sundae; Adams and
 BDF) on the numba RHS. Each runs a small tolerance ladder; "equal accuracy" = the cheapest run of
 each peer whose error is below ``--target``; ratio = its time / jaxcelt Tsit5's.
@@ -30,7 +30,7 @@ import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
-import _peers  # noqa: E402
+import _numba_model as nm  # noqa: E402
 
 import jaxcelt as jc  # noqa: E402
 from jaxcelt import benchmarking as bm  # noqa: E402
@@ -56,11 +56,13 @@ def _scipy(scene, method, f, rtol):
     return np.array(ys), time.perf_counter() - t0, nfev, ok
 
 
-def _cvode(scene, method, P, rtol):
+def _cvode(scene, method, rtol):
     from sksundae.cvode import CVODE
 
+    P, B, Bi = nm.pack(scene.params)
+
     def rhs(t, y, yp):
-        _peers.rhs_nb(t, y, P, yp)
+        nm.rhs(t, y, P, B, Bi, yp)
 
     s = CVODE(rhs, method=method, rtol=rtol, atol=rtol * 1e-2, max_num_steps=1_000_000)
     t0 = time.perf_counter()
@@ -73,23 +75,17 @@ def _cvode(scene, method, P, rtol):
 
 
 def _numba_ens(scene, rtol, lanes=1, Y0=None):
-    P = _peers.pack_params(scene.params)
     Y0 = np.tile(np.asarray(scene.y0, float), (lanes, 1)) if Y0 is None else Y0
-    PP = np.tile(P, (lanes, 1))
-    out = np.empty((lanes, len(scene.ts), 13))
-    stats = np.zeros((lanes, 3), np.int64)
-    ts = np.asarray(scene.ts, float)
     t0 = time.perf_counter()
-    _peers.dopri5_ensemble(Y0, PP, ts, rtol, rtol * 1e-2, 1_000_000, out, stats)
+    out, steps, evals, status = nm.ensemble(Y0, scene.ts, scene.params, rtol, rtol * 1e-2, 1_000_000)
     sec = time.perf_counter() - t0
-    return (out[0] if lanes == 1 else out), sec, int(stats[:, 0].sum()) * 6, bool(np.all(stats[:, 2] == 0))
+    return (out[0] if lanes == 1 else out), sec, int(evals.sum()), bool(np.all(status == 0))
 
 
 def single(scene, ys_ref, rtols, target, numpy_rhs: bool, quick: bool = False):
     rows = []
-    P = _peers.pack_params(scene.params)
-    fn = _peers.numba_rhs(scene.params)
-    fp = _peers.numpy_rhs(scene.params)
+    fn = nm.numba_rhs(scene.params)
+    fp = nm.python_rhs(scene.params)
     _numba_ens(scene, 1e-6)  # compile
     for m in ("DOP853", "Radau"):  # warm up the scipy paths (numba specialises on the call signature)
         _scipy(bm.Scene(scene.name, scene.params, scene.y0, 0.01, np.array([0.0, 0.01]), ""), m, fn, 1e-4)
@@ -124,11 +120,11 @@ def single(scene, ys_ref, rtols, target, numpy_rhs: bool, quick: bool = False):
         for m in ("DOP853", "LSODA", "Radau"):
             add(f"scipy {m} + numba RHS", *_scipy(scene, m, fn, rtol), rtol)
             if numpy_rhs and m == "DOP853":
-                add(f"scipy {m} + numpy RHS", *_scipy(scene, m, fp, rtol), rtol)
+                add(f"scipy {m} + Python RHS (interpreted)", *_scipy(scene, m, fp, rtol), rtol)
         add("numba DP5 (hand-written)", *_numba_ens(scene, rtol), rtol)
         for m in ("Adams", "BDF"):
             try:
-                add(f"CVODE {m} + numba RHS", *_cvode(scene, m, P, rtol), rtol)
+                add(f"CVODE {m} + numba RHS", *_cvode(scene, m, rtol), rtol)
             except ImportError:
                 pass
     # equal accuracy: cheapest run per peer with error <= target

@@ -5,7 +5,7 @@ For each scene (`jaxcelt.benchmarking.make_scene`) and horizon:
 * A: diffrax ``Dopri8`` (jaxcelt.simulate, rtol = atol = 1e-13, samples stepped onto exactly);
 * B: scipy ``solve_ivp(DOP853)`` (Hairer's code, a different implementation and step-size
   controller) at rtol = atol = 1e-13, restarted on every sample interval so samples are solver
-  states; its right-hand side is the numba port in ``benchmarks/_peers.py`` (an independent
+  states; its right-hand side is the numba port in ``benchmarks/_numba_model.py`` (an independent
   implementation of MODEL.md) when numba is available, else the jitted JAX field.
 
 Agreement = max |y_A - y_B| over components at each sample time (SI units). The "trusted horizon"
@@ -43,9 +43,9 @@ def scipy_dop853(scene: bm.Scene, tol: float = TOL, rhs: str = "numba"):
     f, name = None, "jax"
     if rhs == "numba":
         try:
-            import _peers
+            import _numba_model
 
-            f, name = _peers.numba_rhs(scene.params), "numba"
+            f, name = _numba_model.numba_rhs(scene.params), "numba"
         except ImportError:
             f = None
     if f is None:

@@ -38,9 +38,25 @@ def test_reference_solvers_agree(ref):
 
 
 def test_numba_port_matches_jax(tiny):
-    _peers = pytest.importorskip("_peers")
+    pytest.importorskip("numba")
+    import _numba_model as nm
+
     # same formulas, different summation order: agreement to a few ulps of the largest entry
-    assert _peers.check_against_jax(tiny.params, n_samples=5) < 1e-12
+    # (observed 2e-15 .. 6e-15 relative); a wrong term shows up at >= 1e-6
+    assert nm.check_against_jax(tiny.params, n_samples=5) < 1e-12
+    # the interpreted source (the "plain Python RHS" peer) is the same function
+    assert nm.check_against_jax(tiny.params, n_samples=2, interpreted=True) < 1e-12
+
+
+def test_numba_ensemble_matches_reference(tiny, ref):
+    pytest.importorskip("numba")
+    import _numba_model as nm
+
+    # hand-written DP5 at rtol 1e-10 over 0.25 s: observed error ~1e-10; 1e-7 catches a broken
+    # tableau, controller or sample placement (those give >= 1e-4)
+    ys, steps, evals, status = nm.ensemble(np.asarray(tiny.y0)[None], tiny.ts, tiny.params, 1e-10, 1e-12)
+    assert status[0] == 0 and steps[0] > 0 and evals[0] >= 6 * steps[0]
+    assert bm.state_error(ys[0], np.asarray(ref["A"]["ys"])) < 1e-7
 
 
 def test_work_precision_quick_path(tiny, ref):
