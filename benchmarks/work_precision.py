@@ -103,6 +103,92 @@ def ladder(scene, name, values, *, ys_ref, law=None, dtype=None, max_run_s=10.0,
     return out
 
 
+TARGETS = (1e-4, 1e-6, 1e-8, 1e-10)
+
+
+def _fmt_int(n) -> str:
+    return "" if n is None else f"{int(n):,}".replace(",", " ")
+
+
+def _cheapest(runs, target, key):
+    """Per solver the cheapest (by ``key``) successful run with error <= target; all solvers sorted by ``key``."""
+    best: dict = {}
+    for r in runs:
+        if "run_s" not in r or r["status"] != 0 or r.get("error") is None or not np.isfinite(r["error"]):
+            continue
+        if r["error"] <= target and r.get(key) is not None:
+            if r["solver"] not in best or r[key] < best[r["solver"]][key]:
+                best[r["solver"]] = r
+    return sorted(best.values(), key=lambda r: r[key])
+
+
+def _ladder_label(r) -> str:
+    return f"rtol {r['rtol']:.0e}" if r.get("rtol") is not None else f"dt {r['dt0']:g} s"
+
+
+def report(res: dict) -> str:
+    """Markdown tables from a work_precision.json dict (docs/performance.md section 2)."""
+    lines = []
+    for sc in res.get("scenes", []):
+        runs = [r for r in sc["runs"] if "run_s" in r]
+        lines.append(f"\n**{sc['description']}** — cheapest run reaching each target error\n")
+        lines.append("| target error | fastest (run time) | runner-up | fewest RHS evaluations (explicit / fixed) |")
+        lines.append("|---|---|---|---|")
+        for t in TARGETS:
+            by_t = _cheapest(runs, t, "run_s")
+            by_n = _cheapest([r for r in runs if r["kind"] != "implicit"], t, "rhs_evals")
+            cell = lambda r: f"{r['solver']} {_ladder_label(r)}: {r['run_s'] * 1e3:.0f} ms, err {r['error']:.1e}"  # noqa: E731
+            f = cell(by_t[0]) if by_t else "none reached it"
+            ru = cell(by_t[1]) if len(by_t) > 1 else ""
+            n = f"{by_n[0]['solver']} {_ladder_label(by_n[0])}: {_fmt_int(by_n[0]['rhs_evals'])}" if by_n else "none"
+            lines.append(f"| {t:.0e} | {f} | {ru} | {n} |")
+        lines.append("\n<details><summary>all runs of this scene</summary>\n")
+        lines.append("| solver | rtol / dt | error | steps acc+rej | RHS evals | run [ms] | compile [s] | status |")
+        lines.append("|---|---|---|---|---|---|---|---|")
+        for r in sc["runs"]:
+            if "run_s" not in r:
+                lines.append(f"| {r['solver']} | | {r.get('skipped') or r.get('error_message', '')[:80]} | | | | | |")
+                continue
+            ev = _fmt_int(r["rhs_evals"]) + ("*" if r["rhs_evals_how"] == "counted" else "")
+            lines.append(
+                f"| {r['solver']} | {_ladder_label(r)} | {r['error']:.2e} | {r['accepted']}+{r['rejected']} | {ev} | "
+                f"{r['run_s'] * 1e3:.1f} | {r['compile_s']:.1f} | {r['status']} |"
+            )
+        lines.append("\n</details>\n")
+    if res.get("float32"):
+        lines.append("\n**float32 vs float64** (error at each rtol; atol = 1e-2 rtol)\n")
+        lines.append("| scene | solver | " + " | ".join(f"{t:.0e}" for t in res["config"]["f32_rtols"]) + " |")
+        lines.append("|---|---|" + "---|" * len(res["config"]["f32_rtols"]))
+        for f in res["float32"]:
+            f64 = [r for sc in res["scenes"] if sc["scene"] == f["scene"] for r in sc["runs"] if "run_s" in r]
+            for s in dict.fromkeys(r["solver"] for r in f["runs"]):
+                for dt, rr in (("float32", f["runs"]), ("float64", f64)):
+                    errs = {r["rtol"]: r for r in rr if r["solver"] == s and "run_s" in r}
+                    cells = []
+                    for t in res["config"]["f32_rtols"]:
+                        r = errs.get(t)
+                        cells.append("" if r is None else f"{r['error']:.1e}" + ("" if r["status"] == 0 else " (fail)"))
+                    lines.append(f"| {f['scene']} | {s} {dt} | " + " | ".join(cells) + " |")
+    if res.get("laws"):
+        lines.append("\n**Contact laws** (rest17, 5 periods; error against the law's own Dopri8 1e-13 reference)\n")
+        lines.append("| law | solver | rtol | error | steps acc+rej | RHS evals | run [ms] | compile [s] |")
+        lines.append("|---|---|---|---|---|---|---|---|")
+        for L in res["laws"]:
+            if L.get("error_message") and not L.get("runs"):
+                lines.append(f"| {L['law']} | | | {L['error_message'][:80]} | | | | |")
+            for r in L.get("runs", []):
+                if "run_s" not in r:
+                    lines.append(
+                        f"| {L['law']} | {r['solver']} | | {r.get('skipped') or r.get('error_message', '')[:80]} | | | | |"
+                    )
+                    continue
+                lines.append(
+                    f"| {L['law']} | {r['solver']} | {r['rtol']:.0e} | {r['error']:.2e} | {r['accepted']}+{r['rejected']} "
+                    f"| {_fmt_int(r['rhs_evals'])} | {r['run_s'] * 1e3:.1f} | {r['compile_s']:.1f} |"
+                )
+    return "\n".join(lines)
+
+
 def config(quick: bool):
     if quick:
         return dict(
@@ -151,7 +237,8 @@ def main(argv=None):
     ap.add_argument("--parts", default="scenes,float32,laws")
     ap.add_argument("--deadline-min", type=float, default=1e9, help="start no new ladder after this many minutes")
     ap.add_argument("--fresh", action="store_true", help="ignore an existing JSON (default: resume)")
-    ap.add_argument("--plot-only", action="store_true")
+    ap.add_argument("--plot-only", action="store_true", help="only redraw the charts from the JSON")
+    ap.add_argument("--report", action="store_true", help="print Markdown tables from the JSON and exit")
     args = ap.parse_args(argv)
     cfg = config(args.quick)
     parts = args.parts.split(",")
@@ -159,6 +246,9 @@ def main(argv=None):
     out.mkdir(parents=True, exist_ok=True)
     tag = "_quick" if args.quick else ""
     path = out / f"work_precision{tag}.json"
+    if args.report:
+        print(report(json.loads(path.read_text())))
+        return None
     info = versions()
     info["device"] = bm.device_string()
     print("versions:", info, flush=True)
