@@ -18,11 +18,13 @@ Model built from `jaxcelt.CeltParams.paper()`:
   cos(omega_pi t) along X1 (derivative of eq. 17); the inertial force -m a_pi(t) is applied at C by
   a motor on the free joint's x dof (ctrl = that force), so `mujoco.rollout` runs it in C.
 
-Scenes: the paper's from-rest scene (omega_pi = 17, 20 periods) and the classic rattleback test,
-spin reversal on a fixed table from omega = (0, 2, -10) rad/s (2.5 s). Output: ``mujoco.json``,
-``mujoco.png`` (omega_s = omega . n and tilt against time, MuJoCo vs jaxcelt).
+Scenes: the paper's from-rest scene (omega_pi = 17, 20 periods) and the classic rattleback test on
+a fixed table: spin the "wrong" way, omega = (0, 2, -10) rad/s, and the "right" way, (0, 2, +10),
+2.5 s each. Output (``--parts scenes``): ``mujoco.json``, ``mujoco.png`` (omega_s = omega . n and
+tilt against time, MuJoCo vs jaxcelt); (``--parts mjx``): ``mujoco_mjx.json``, MJX
+``jit(vmap(scan(mjx.step)))`` over lanes, compile and run time apart.
 
-    python benchmarks/mujoco_peer.py [--out docs/performance] [--mjx-lanes 1,16,64,256] [--budget 600]
+    python benchmarks/mujoco_peer.py [--out docs/performance] [--parts scenes,mjx] [--mjx-lanes 1,16,64,256] [--budget 600]
 """
 
 from __future__ import annotations
@@ -186,6 +188,7 @@ def main(argv=None):
     ap.add_argument("--mjx-lanes", default="1,16,64,256")
     ap.add_argument("--mjx-periods", type=int, default=2)
     ap.add_argument("--budget", type=float, default=600.0, help="wall-second cap for the MJX scaling")
+    ap.add_argument("--parts", default="scenes,mjx")
     args = ap.parse_args(argv)
     out = pathlib.Path(args.out)
     info = versions()
@@ -203,34 +206,46 @@ def main(argv=None):
     scenes = {
         "rest17": (p17, (0.0, 0.0, 0.0), T17, f"from rest, omega_pi = 17, {args.periods} periods ({T17:.2f} s)"),
         "spin_reversal": (p_fix, (0.0, 2.0, -10.0), 2.5, "fixed table, omega0 = (0, 2, -10) rad/s, 2.5 s"),
-        "spin_right_way": (p_fix, (0.0, 0.0, 10.0), 2.5, "fixed table, omega0 = (0, 0, +10) rad/s, 2.5 s"),
+        "spin_right_way": (p_fix, (0.0, 2.0, 10.0), 2.5, "fixed table, omega0 = (0, 2, +10) rad/s, 2.5 s"),
     }
+    parts = args.parts.split(",")
     res = dict(versions=info, friction=dict(zip(("sliding", "torsional_m", "rolling_m"), friction(p17))), scenes={})
-    for key, (p, w0, T, desc) in scenes.items():
+    for key, (p, w0, T, desc) in scenes.items() if "scenes" in parts else ():
         print(f"{key}: {desc}", flush=True)
-        t, ws, tilt, run_s, comp_s, steps = run_jaxcelt(p, w0, T)
+        t, ws, tilt, run_s, comp_s, steps = run_jaxcelt(p, w0, T, n_out=1000 if T > 5 else 500)
         sc = dict(description=desc, sim_s=T, runs=[])
         sc["runs"].append(dict(name="jaxcelt Tsit5 rtol 1e-8", run_s=run_s, compile_s=comp_s, steps=steps,
-                               run_s_per_sim_s=run_s / T, t=t[::5].tolist(), omega_s=ws[::5].tolist(),
-                               tilt=tilt[::5].tolist()))  # fmt: skip
+                               run_s_per_sim_s=run_s / T, **_trace(t, ws, tilt, 1)))  # fmt: skip
         print(f"  jaxcelt: {run_s * 1e3:.1f} ms ({steps} steps), omega_s end {ws[-1]:+.2f}", flush=True)
         for dt, integ in ((2e-3, "Euler"), (2e-4, "Euler"), (2e-3, "RK4")):
             t, ws, tilt, run_s, nstep = run_mujoco(p, w0, T, dt, integ)
-            k = max(1, len(t) // 500)
             sc["runs"].append(dict(name=f"MuJoCo {integ} dt {dt:g}", run_s=run_s, steps=nstep, run_s_per_sim_s=run_s / T,
-                                   finite=bool(np.all(np.isfinite(ws))), t=t[::k].tolist(), omega_s=ws[::k].tolist(),
-                                   tilt=tilt[::k].tolist()))  # fmt: skip
+                                   finite=bool(np.all(np.isfinite(ws))), **_trace(t, ws, tilt, max(1, len(t) // 1000))))  # fmt: skip
             print(
                 f"  MuJoCo {integ} dt {dt:g}: {run_s * 1e3:.1f} ms ({nstep} steps), omega_s end {ws[-1]:+.2f}",
                 flush=True,
             )
         res["scenes"][key] = sc
-    T_mjx = args.mjx_periods * 2 * np.pi / 17.0
-    print(f"MJX scaling: rest17, {args.mjx_periods} periods, dt 2e-3", flush=True)
-    res["mjx"] = mjx_scaling(p17, T_mjx, 2e-3, [int(x) for x in args.mjx_lanes.split(",")], args.budget)
-    (out / "mujoco.json").write_text(json.dumps(res, indent=1, default=float))
-    plot(res).savefig(out / "mujoco.png", dpi=110)
+    if "scenes" in parts:
+        plot(res).savefig(out / "mujoco.png", dpi=110)
+        for sc in res["scenes"].values():  # thin the traces in the JSON (the figure used them all)
+            for r in sc["runs"]:
+                k = -(-len(r["t"]) // 500)
+                r.update({a: r[a][::k] for a in ("t", "omega_s", "tilt")})
+        (out / "mujoco.json").write_text(json.dumps(res, separators=(",", ":"), default=float))
+    if "mjx" in parts:
+        T_mjx = args.mjx_periods * 2 * np.pi / 17.0
+        desc = f"rest17, {args.mjx_periods} periods ({T_mjx:.3f} s), dt 2e-3, initial spin + N(0, 0.05^2) rad/s"
+        print(f"MJX scaling: {desc}", flush=True)
+        mjx_rows = mjx_scaling(p17, T_mjx, 2e-3, [int(x) for x in args.mjx_lanes.split(",")], args.budget)
+        (out / "mujoco_mjx.json").write_text(json.dumps(dict(versions=info, scene=desc, mjx=mjx_rows), indent=1))
     return res
+
+
+def _trace(t, ws, tilt, k):
+    """Downsampled traces for the JSON (5 significant digits keep the file small)."""
+    r = lambda a: [float(f"{x:.5g}") for x in np.asarray(a)[::k]]  # noqa: E731
+    return dict(t=r(t), omega_s=r(ws), tilt=r(tilt))
 
 
 def plot(res):
