@@ -2,9 +2,10 @@
 
 Sections (``--only`` picks some): ``recover`` (noise-free recovery, full state and IMU),
 ``compare`` (Adam vs L-BFGS vs Gauss-Newton vs LM on one problem), ``coverage`` (1% noise, 20
-seeds), ``chaos`` (omega_pi = 19, 20 periods: single vs multiple shooting; also ``chaos-single``,
-``chaos-single-damped``, ``chaos-multiple``, ``chaos-multiple-lm`` one at a time), ``gradnorm``
-(gradient norm vs window length against e^{lambda T}).
+seeds), ``chaos`` (omega_pi = 19, 40 periods from rest: ``chaos-record`` validity and Lyapunov
+exponent of the record, then ``chaos-multiple``, ``chaos-single``, ``chaos-single-damped``; each
+can be run alone), ``gradnorm`` (gradient norm vs window length against e^{lambda T}; needs
+``chaos-record`` first).
 
 Usage: python scripts/fit_study.py [--only recover compare ...] [--seeds 20] [--out docs/fit]
 """
@@ -159,40 +160,175 @@ def coverage(out, seeds):
     FP.plot_coverage(rows, TRUE, FREE).savefig(out / "coverage.png", dpi=110)
 
 
-# Chaotic regime: the paper's parameters at omega_pi = 19, released at rest, 20 forcing periods.
-# With the fit's TRUE parameters (above) at omega_pi = 19 every chaotic start tips past 90 deg
-# (n3 < 0, outside the model) and the one that stays valid (10 deg tilt, spin -3) has lambda ~ 0;
-# so here the roles swap: the data come from the paper's values, the fit starts from TRUE (mu +40%,
-# k_r -40%, b_Ts +50%, m_Ts +35% off the truth), where the stone released at rest tips over
-# within the record.
-CHAOS_PERIODS = 20
-CHAOS_RATE = 10 * 19.0 / (2 * np.pi)  # 10 samples per forcing period (30.2 Hz)
+# Chaotic regime (must show 3): the paper's parameters at omega_pi = 19, released at rest,
+# 40 forcing periods (13.2 s), full state at 20 samples per period (60.5 Hz), noise-free. At
+# omega_pi = 19 every release tried tips past 90 deg eventually (n3 < 0, outside the model; from
+# rest after 48.7 periods); the record ends before that and stays valid (max tilt 47 deg), and
+# along it the largest Lyapunov exponent (jaxcelt.lyapunov, Benettin) is positive. Roles: the data
+# come from the paper's values, every fit starts from the study's TRUE values (mu +40%,
+# k_r -40%, b_Ts +50%, m_Ts +35% off the truth).
+CHAOS_OMEGA = 19.0
+CHAOS_PERIODS = 40
+CHAOS_SPP = 20  # samples per forcing period
+CHAOS_TP = 2 * np.pi / CHAOS_OMEGA  # forcing period [s]
+CHAOS_TRUTH = PAPER.replace(omega_pi=CHAOS_OMEGA)
+CHAOS_START = TRUE.replace(omega_pi=CHAOS_OMEGA)
+CHAOS_FIT = dict(sim_rtol=1e-8, sim_atol=1e-10, max_steps=100_000)
 
 
 def chaos_data():
-    p19 = PAPER.replace(omega_pi=19.0)
-    T = CHAOS_PERIODS * 2 * np.pi / 19.0
-    return D.generate_data(p19, jc.initial_state(p19), T, rate=CHAOS_RATE, kinds=("state",), omega_pis=[19.0])
+    p = CHAOS_TRUTH
+    return D.generate_data(
+        p,
+        jc.initial_state(p),
+        CHAOS_PERIODS * CHAOS_TP,
+        rate=CHAOS_SPP / CHAOS_TP,
+        kinds=("state",),
+        omega_pis=[CHAOS_OMEGA],
+    )
+
+
+def _lyap(p, y0, periods, rtol=1e-9):
+    from jaxcelt.lyapunov import celt_lyapunov
+
+    r = celt_lyapunov(p, y0, periods=periods, rtol=rtol, atol=rtol * 1e-2)
+    return np.asarray(r.log_growth), bool(r.success)
+
+
+def chaos_record(out):
+    """Validity of the record along the truth and its largest Lyapunov exponent."""
+    p, tp = CHAOS_TRUTH, CHAOS_TP
+    y0 = jc.initial_state(p)
+    res = dict(record=_chaos_record_text())
+    t = time.perf_counter()
+    ts = np.linspace(0.0, CHAOS_PERIODS * tp, CHAOS_PERIODS * 40 + 1)
+    sol = jc.simulate(p, y0, CHAOS_PERIODS * tp, ts=ts, rtol=1e-10, atol=1e-12)
+    res["record_valid"] = bool(sol.valid)
+    res["record_status"] = int(sol.status)
+    res["record_max_tilt_deg"] = float(np.degrees(sol.validity.max_tilt))
+    res["record_min_N"] = float(sol.validity.min_N)
+    tilt = np.degrees(np.arccos(np.clip(np.asarray(sol.ys)[:, 8], -1, 1)))
+    # how long the same motion stays valid (it tips over later)
+    long = jc.simulate(p, y0, 100 * tp, rtol=1e-10, atol=1e-12)
+    res["continuation_first_invalid_periods"] = float(long.validity.first_invalid_t) / tp
+    res["continuation_first_invalid_kind"] = int(long.validity.first_invalid_kind)
+    # Benettin exponent, renormalised once per period, along the record; two tolerances
+    lams = {}
+    for rtol in (1e-9, 1e-11):
+        lg, ok = _lyap(p, y0, CHAOS_PERIODS, rtol)
+        lams[rtol] = lg
+        res[f"log_growth_rtol{rtol:g}"] = lg.tolist()
+        res[f"success_rtol{rtol:g}"] = ok
+    lg = lams[1e-9]
+    n = CHAOS_PERIODS
+    res["lambda_record"] = float(lg.sum() / (n * tp))
+    res["lambda_record_skip1"] = float(lg[1:].sum() / ((n - 1) * tp))  # first period: alignment
+    res["lambda_first_half"] = float(lg[: n // 2].sum() / (n // 2 * tp))
+    res["lambda_second_half"] = float(lg[n // 2 :].sum() / (n // 2 * tp))
+    res["lambda_record_rtol1e-11"] = float(lams[1e-11].sum() / (n * tp))
+    res["periods_with_negative_growth"] = int(np.sum(lg < 0))
+    res["lambda_T_record"] = res["lambda_record"] * n * tp
+    # convergence reference: a release that stays valid longer (spin -3 rad/s, 80 periods)
+    y_ref = jc.initial_state(p, omega=(0.0, 0.0, -3.0))
+    ref = jc.simulate(p, y_ref, 80 * tp, rtol=1e-10, atol=1e-12)
+    lg_ref, _ = _lyap(p, y_ref, 80)
+    res["reference"] = dict(
+        release="at rest on the base, spinning omega3 = -3 rad/s",
+        valid_80_periods=bool(ref.valid),
+        max_tilt_deg=float(np.degrees(ref.validity.max_tilt)),
+        log_growth=lg_ref.tolist(),
+        running_mean={int(k): float(lg_ref[:k].sum() / (k * tp)) for k in (10, 20, 40, 60, 80)},
+    )
+    # the start parameters from rest: where the trajectory leaves the model
+    s0 = jc.simulate(CHAOS_START, y0, n * tp, rtol=1e-10, atol=1e-12)
+    res["start_first_invalid_periods"] = float(s0.validity.first_invalid_t) / tp
+    res["start_max_tilt_deg"] = float(np.degrees(s0.validity.max_tilt))
+    # the same growth without linearisation: two releases 1e-7 apart (omega3), separation per
+    # period (r_C left out, as in the Lyapunov norm), tight tolerances
+    tk = np.arange(n + 1) * tp
+    mask = np.r_[np.ones(9), np.zeros(3), 1.0]
+    ya = np.asarray(jc.simulate(p, y0, n * tp, ts=tk, rtol=1e-12, atol=1e-14).ys)
+    yb = np.asarray(
+        jc.simulate(p, jc.initial_state(p, omega=(0.0, 0.0, 1e-7)), n * tp, ts=tk, rtol=1e-12, atol=1e-14).ys
+    )
+    sep = np.linalg.norm((yb - ya) * mask, axis=1)
+    res["fd_log_separation_per_period"] = np.log(sep[1:] / sep[0]).tolist()
+    res["tilt_deg"] = tilt.tolist()
+    res["tilt_ts"] = ts.tolist()
+    res["time_s"] = time.perf_counter() - t
+    print({k: v for k, v in res.items() if not isinstance(v, (list, dict))}, flush=True)
+    print(
+        "fd log separation at 20, 40 periods:",
+        res["fd_log_separation_per_period"][19],
+        res["fd_log_separation_per_period"][-1],
+    )
+    (out / "chaos_record.json").write_text(json.dumps(res, indent=1))
+    plot_chaos_record(out)
+
+
+def plot_chaos_record(out):
+    """chaos_record.png from chaos_record.json."""
+    import matplotlib.pyplot as plt
+
+    res = json.loads((out / "chaos_record.json").read_text())
+    tp, n = CHAOS_TP, CHAOS_PERIODS
+    lg = np.asarray(res["log_growth_rtol1e-09"])
+    fig, ax = plt.subplots(1, 2, figsize=(11.5, 4.2), constrained_layout=True)
+    a = ax[0]
+    a.plot(res["tilt_ts"], res["tilt_deg"], lw=0.8, label="tilt arccos(n3) along the record (truth)")
+    a.axhline(90, color="r", ls=":", label="90°: contact leaves the lower half (model invalid)")
+    a.set(xlabel="t [s]", ylabel="tilt [deg]", title=f"record: ω_π = 19 rad/s, from rest, {n} periods", ylim=(0, 100))
+    a.legend(fontsize=8, loc="upper left")
+    a = ax[1]
+    tk = tp * np.arange(1, n + 1)
+    a.plot(
+        tk, np.cumsum(lg), ".-", ms=3, label=f"record, Benettin: λ = {res['lambda_record']:.2f} 1/s over {n} periods"
+    )
+    a.plot(tk, np.cumsum(res["log_growth_rtol1e-11"]), ":", color="k", lw=1, label="same, rtol 1e-11")
+    fd = res.get("fd_log_separation_per_period")
+    if fd is not None:
+        a.plot(tk, fd, "-", color="tab:green", lw=1, label="record, two releases 1e-7 apart (ω3): log separation")
+    ref = res["reference"]
+    lr = np.asarray(ref["log_growth"])
+    a.plot(
+        tp * np.arange(1, lr.size + 1),
+        np.cumsum(lr),
+        "-",
+        lw=1,
+        color="tab:orange",
+        label=f"release spinning ω3 = −3 rad/s: λ = {ref['running_mean']['80']:.2f} 1/s over 80 periods",
+    )
+    a.axvline(n * tp, color="0.5", ls="--", lw=0.8, label="end of the record")
+    a.set(xlabel="t [s]", ylabel="log growth of a perturbation (cumulative)", title="largest Lyapunov exponent")
+    a.legend(fontsize=7.5, loc="lower right")
+    fig.savefig(out / "chaos_record.png", dpi=110)
+
+
+def _chaos_record_text():
+    return (
+        f"paper parameters, omega_pi={CHAOS_OMEGA:g}, from rest, {CHAOS_PERIODS} periods "
+        f"({CHAOS_PERIODS * CHAOS_TP:.2f} s), full state at {CHAOS_SPP} samples/period "
+        f"({CHAOS_SPP / CHAOS_TP:.1f} Hz), noise-free"
+    )
 
 
 def _chaos_fit(out, label, tag, optimiser="lm", **kw):
     data = chaos_data()
     D.save_data(data, out / "chaos_data.npz")
-    p0 = TRUE.replace(omega_pi=19.0)
-    truth = PAPER.replace(omega_pi=19.0)
+    truth = CHAOS_TRUTH
     t = time.perf_counter()
-    res = F.fit(data, p0, free=FREE, optimiser=optimiser, sim_rtol=1e-7, sim_atol=1e-9, max_steps=100_000, **kw)
+    res = F.fit(data, CHAOS_START, free=FREE, optimiser=optimiser, **(CHAOS_FIT | kw))
     print(label, f"{time.perf_counter() - t:.1f}s", res.summary(), flush=True)
     r = row(res, label)
     r["rel_err"] = res.relative_error(truth)
     r["max_rel_err"] = max(r["rel_err"].values())
     r["covers"] = res.covers(truth)
     r["loss_history"] = res.loss_history
+    r["settings"] = {k: v for k, v in (CHAOS_FIT | kw).items()}
     (out / f"chaos_{tag}.json").write_text(
         json.dumps(
             dict(
-                record=f"paper parameters, omega_pi=19, from rest, {CHAOS_PERIODS} periods "
-                f"({float(data.trajectories[0].ts[-1]):.2f} s), full state at {CHAOS_RATE:.1f} Hz, noise-free",
+                record=_chaos_record_text(),
                 start="TRUE values of the study (mu 0.3137, k_r 0.2607, b_Ts 0.7958, m_Ts 1.1017)",
                 truth={n: float(getattr(truth, n)) for n in FREE},
                 row=r,
@@ -200,82 +336,98 @@ def _chaos_fit(out, label, tag, optimiser="lm", **kw):
             indent=1,
         )
     )
-    FP.plot_fit(res, title=label, true=truth, kind="state", channels=(3, 4, 5)).savefig(
-        out / f"chaos_{tag}.png", dpi=110
-    )
+    fig = FP.plot_fit(res, title=label, true=truth, kind="state", channels=(3, 4, 5))
+    for a in fig.axes[:3]:
+        a.set_ylabel("[rad/s]")
+    fig.savefig(out / f"chaos_{tag}.png", dpi=110)
+    return res
 
 
 def chaos_single(out):
-    _chaos_fit(out, "single shooting", "single", windows=1, max_iter=20, max_time=1200.0)
+    _chaos_fit(out, "single shooting, LM", "single", windows=1, max_iter=30, max_time=600.0)
 
 
 def chaos_single_damped(out):
     _chaos_fit(
-        out, "single shooting, damped GN", "single_gnd", optimiser="gn-damped", windows=1, max_iter=20, max_time=300.0
+        out, "single shooting, damped GN", "single_gnd", optimiser="gn-damped", windows=1, max_iter=30, max_time=600.0
     )
 
 
 def chaos_multiple(out):
-    # states from the data; the continuity residual at the window ends is then one more data
-    # term: weight 1 (not the 1e4 that ties optimised states), damped GN
+    # window states from the (full-state) data; the continuity residual at the window ends is
+    # then one more data term: weight 1 (not the 1e4 that ties optimised states), damped GN
     _chaos_fit(
         out,
-        f"multiple shooting, {CHAOS_PERIODS} windows (states from data), damped GN, continuity weight 1",
+        f"multiple shooting, {CHAOS_PERIODS} windows (states from data), damped GN",
         "multiple_gnd",
         optimiser="gn-damped",
         continuity_weight=1.0,
         windows=CHAOS_PERIODS,
         window_states="data",
-        max_iter=20,
-        max_time=1100.0,
-    )
-
-
-def chaos_multiple_lm(out):
-    # the first attempt: LM with continuity weight 1e4 rejected every step within the budget
-    _chaos_fit(
-        out,
-        f"multiple shooting, {CHAOS_PERIODS} windows (states from data)",
-        "multiple",
-        windows=CHAOS_PERIODS,
-        window_states="data",
-        max_iter=20,
-        max_time=1200.0,
+        max_iter=30,
+        max_time=900.0,
     )
 
 
 def chaos(out):
+    chaos_record(out)
+    chaos_multiple(out)
     chaos_single(out)
     chaos_single_damped(out)
-    chaos_multiple(out)
 
 
 def gradnorm(out):
+    """|dL/dtheta| of single shooting on [0, T] vs T, at the fit's start and near the truth."""
     data = chaos_data()
-    tr = data.trajectories[0]
-    truth = PAPER.replace(omega_pi=19.0)
-    p0 = TRUE.replace(omega_pi=19.0)
-    T1 = float(tr.ts[-1])
-    res = dict(record="as chaos_*.json")
-    for tag, p in (("truth", truth), ("start", p0)):
-        ts, lg, lam = F.finite_time_lyapunov(p, tr.y0, T1, n_samples=81)
-        res[f"lambda_{tag}"] = lam
-        res[f"tangent_ts_{tag}"] = ts.tolist()
-        res[f"tangent_log_norm_{tag}"] = lg.tolist()
-        print(tag, "lambda", lam, flush=True)
-    T, g = F.gradient_norm_vs_window(data, p0, free=FREE, sim_rtol=1e-7, sim_atol=1e-9, max_steps=100_000)
-    res |= dict(window_T=T.tolist(), grad_norm=g.tolist(), gradient_at="start parameters (TRUE)")
+    rec = json.loads((out / "chaos_record.json").read_text())
+    lam = rec["lambda_record"]
+    near = CHAOS_TRUTH.replace(
+        **{n: float(getattr(CHAOS_TRUTH, n)) * f for n, f in zip(FREE, (1.01, 0.99, 1.01, 0.99))}
+    )
+    res = dict(record=_chaos_record_text(), lambda_record=lam, points={})
+    for tag, p in (("start", CHAOS_START), ("near", near)):
+        t = time.perf_counter()
+        T, g = F.gradient_norm_vs_window(data, p, free=FREE, **CHAOS_FIT)
+        res["points"][tag] = dict(
+            params={n: float(getattr(p, n)) for n in FREE},
+            T=T.tolist(),
+            grad_norm=g.tolist(),
+            time_s=time.perf_counter() - t,
+        )
+        print(tag, f"{time.perf_counter() - t:.1f}s", "g at 1 period, end:", g[CHAOS_SPP - 1], g[-1], flush=True)
     (out / "gradnorm.json").write_text(json.dumps(res, indent=1))
-    print("T", T[::20], "g", g[::20])
-    FP.plot_gradient_norm(
-        T,
-        g,
-        res["lambda_start"],
-        np.asarray(res["tangent_ts_start"]),
-        np.asarray(res["tangent_log_norm_start"]),
-        window=2 * np.pi / 19.0,
-        lam_label="λ(start)",
-    ).savefig(out / "gradnorm.png", dpi=110)
+    plot_gradnorm(out)
+
+
+def plot_gradnorm(out):
+    """gradnorm.png from gradnorm.json."""
+    import matplotlib.pyplot as plt
+
+    res = json.loads((out / "gradnorm.json").read_text())
+    lam = res["lambda_record"]
+    fig, a = plt.subplots(figsize=(7.6, 4.8), constrained_layout=True)
+    i = CHAOS_SPP - 1  # one period: the multiple-shooting window
+    for tag, lab, c in (
+        ("start", "at the fit's start (35–50% off)", "tab:red"),
+        ("near", "1% off the truth", "tab:blue"),
+    ):
+        d = res["points"][tag]
+        T, g = np.asarray(d["T"]), np.asarray(d["grad_norm"])
+        a.semilogy(T, g, lw=1.3, color=c, label=f"|∂L/∂z|, single shooting on [0, T], {lab}")
+        a.semilogy(T[i:], g[i] * np.exp(lam * (T[i:] - T[i])), "--", color=c, lw=0.9)
+        a.semilogy(T[i:], g[i] * np.exp(2 * lam * (T[i:] - T[i])), ":", color=c, lw=0.9)
+    a.plot([], [], "k--", lw=0.9, label=rf"$\propto e^{{\lambda T}}$ from one period, λ = {lam:.2f} 1/s (record)")
+    a.plot([], [], "k:", lw=0.9, label=r"$\propto e^{2\lambda T}$ from one period")
+    a.axvline(
+        CHAOS_TP, color="tab:green", ls="-.", lw=1, label=f"multiple-shooting window (1 period, {CHAOS_TP:.2f} s)"
+    )
+    a.set(
+        xlabel="record length T [s]",
+        ylabel="|∂L/∂z| (z: the fit's unconstrained parameters)",
+        title="gradient norm vs window length, ω_π = 19 rad/s record",
+    )
+    a.legend(fontsize=7.5, loc="lower right")
+    fig.savefig(out / "gradnorm.png", dpi=110)
 
 
 def main():
