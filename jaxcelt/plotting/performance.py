@@ -66,7 +66,7 @@ def _ladder_value(r) -> str:
     if r.get("rtol") is not None:
         return f"{np.log10(r['rtol']):.0f}"
     if r.get("dt0") is not None:
-        return f"{r['dt0'] * 1e3:g}"
+        return f"{r['dt0'] * 1e3:.2g}"
     return ""
 
 
@@ -101,7 +101,7 @@ def _wp_lines(axes, runs, group, style, annotate=True):
 def _wp_finish(fig, axes, title, legend_ax, note=None):
     labels = {
         "run_s": "run time [s] (compile excluded; best of 1-2 repeats)",
-        "rhs_evals": "RHS evaluations (accepted + rejected steps)",
+        "rhs_evals": "RHS evaluations (implicit: without Jacobian columns)",
         "rtol": "rtol (atol = 1e-2 rtol)",
     }
     for xkey, ax in axes:
