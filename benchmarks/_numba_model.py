@@ -165,8 +165,14 @@ _E = _B5 - np.array([5179 / 57600, 0, 7571 / 16695, 393 / 640, -92097 / 339200, 
 
 
 @nb.njit(cache=True)
-def _dopri_lane(y0, t0, ts, P, B, Bi, rtol, atol, max_steps, out_ys, C, A, B5, E):
-    """Integrate one lane, stepping exactly onto each ts[j]; returns (steps, rhs_evals, status)."""
+def _dopri_lane(y0, t0, ts, P, B, Bi, rtol, atol, max_steps, out_ys, C, A, B5, E, stop_invalid=False):
+    """Integrate one lane, stepping exactly onto each ts[j]; returns (steps, rhs_evals, status).
+
+    ``stop_invalid``: end the lane (status 2) at the first accepted step whose end state has
+    N <= 0 (lift-off) or n3 <= 0, as ``jaxcelt``'s ``stop_on_invalid`` does. N comes free from
+    the FSAL derivative: the normal projection of m (v_dot + w x v) = -m g n + N (n + t) with
+    t . n = 0 gives N = m ((v_dot + w x v) . n + g).
+    """
     n = 13
     y = y0.copy()
     K = np.empty((7, n))
@@ -216,13 +222,18 @@ def _dopri_lane(y0, t0, ts, P, B, Bi, rtol, atol, max_steps, out_ys, C, A, B5, E
             if hit:
                 out_ys[j] = y
                 j += 1
+            if stop_invalid:
+                c0, c1, c2 = _cross(y[3], y[4], y[5], y[0], y[1], y[2])
+                N = P[M] * ((K[0, 0] + c0) * y[6] + (K[0, 1] + c1) * y[7] + (K[0, 2] + c2) * y[8] + P[GRAV])
+                if N <= 0.0 or y[8] <= 0.0:
+                    return steps, evals, 2
         fac = 10.0 if err == 0 else min(10.0, max(0.2, 0.9 * err ** (-1 / 5)))
         h = hh * fac
     return steps, evals, 0
 
 
 @nb.njit(parallel=True, cache=True)
-def dopri_ensemble(Y0, TS, PP, B, Bi, rtol, atol, max_steps):
+def dopri_ensemble(Y0, TS, PP, B, Bi, rtol, atol, max_steps, stop_invalid=False):
     """All lanes (prange over lanes): Y0 (L, 13), TS (L, S), PP (L, NP) -> (ys (L, S, 13), steps, evals, status)."""
     L, S = TS.shape
     ys = np.full((L, S, 13), np.inf)
@@ -230,7 +241,9 @@ def dopri_ensemble(Y0, TS, PP, B, Bi, rtol, atol, max_steps):
     evals = np.zeros(L, np.int64)
     status = np.zeros(L, np.int64)
     for k in nb.prange(L):
-        s, e, st = _dopri_lane(Y0[k], 0.0, TS[k], PP[k], B, Bi, rtol, atol, max_steps, ys[k], _C, _A, _B5, _E)
+        s, e, st = _dopri_lane(
+            Y0[k], 0.0, TS[k], PP[k], B, Bi, rtol, atol, max_steps, ys[k], _C, _A, _B5, _E, stop_invalid
+        )
         steps[k], evals[k], status[k] = s, e, st
     return ys, steps, evals, status
 

@@ -23,9 +23,24 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _enable_compile_cache() -> None:
+    """Persistent XLA compilation cache for the command line (a rerun or a resumed sweep skips
+    the compile). Directory: $JAXCELT_CACHE_DIR, default ~/.cache/jaxcelt/xla; "off" disables."""
+    import os
+
+    import jax
+
+    d = os.environ.get("JAXCELT_CACHE_DIR", os.path.join(os.path.expanduser("~"), ".cache", "jaxcelt", "xla"))
+    if d.strip().lower() in ("", "0", "off", "none"):
+        return
+    jax.config.update("jax_compilation_cache_dir", d)
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    _enable_compile_cache()
     if args.version:
         from .versions import versions_string
 

@@ -39,6 +39,7 @@ import diffrax
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from . import _config  # noqa: F401
 from ._types import Array, Scalar
@@ -48,7 +49,9 @@ from .params import CeltParams
 
 __all__ = ["LyapunovResult", "largest_lyapunov", "celt_lyapunov", "celt_tangent_projection", "CELT_NORM_MASK"]
 
-CELT_NORM_MASK = jnp.array([1.0] * 9 + [0.0] * 3 + [1.0])
+# numpy, not jnp: a module-level jnp array would initialise the JAX backend on import
+# (then `jax.config.update("jax_num_cpu_devices", n)` could no longer be set)
+CELT_NORM_MASK = np.array([1.0] * 9 + [0.0] * 3 + [1.0])
 """Weights of the 13 state components in the tangent norm: r_C (9:12) excluded."""
 
 
@@ -224,7 +227,7 @@ def celt_lyapunov(
         segment=T,
         n_segments=periods,
         n_transient_segments=transient_periods,
-        norm_weights=CELT_NORM_MASK.astype(jnp.asarray(y0).dtype),
+        norm_weights=jnp.asarray(CELT_NORM_MASK, dtype=jnp.asarray(y0).dtype),
         project=celt_tangent_projection,
         solver=solver,
         rtol=rtol,

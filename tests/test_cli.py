@@ -1,6 +1,9 @@
 """The `jaxcelt simulate` command: writes data + figure, reports bad input with exit code 2."""
 
 import json
+import os
+import subprocess
+import sys
 
 import numpy as np
 
@@ -25,3 +28,24 @@ def test_simulate_rejects_bad_parameter(tmp_path, capsys):
     rc = main(["simulate", "--set", "m=-1", "--out", str(tmp_path)])
     assert rc == 2
     assert "'m'" in capsys.readouterr().out
+
+
+def test_import_does_not_start_the_jax_backend():
+    # `jax.config.update("jax_num_cpu_devices", n)` (the CLI's --host-devices) only works before
+    # the backend starts; a module-level jnp array anywhere in jaxcelt would start it on import.
+    code = (
+        "import jax, jaxcelt, jaxcelt.cli, jaxcelt.commands.bifurcation, jaxcelt.plotting\n"
+        "jax.config.update('jax_num_cpu_devices', 2)\n"
+        "print(len(jax.devices('cpu')))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "2"
+
+
+def test_compile_cache_is_written(tmp_path):
+    # the CLI's persistent XLA cache: a run fills $JAXCELT_CACHE_DIR (a rerun then skips compiling)
+    cache = tmp_path / "xla"
+    env = dict(os.environ, JAXCELT_CACHE_DIR=str(cache))
+    cmd = [sys.executable, "-m", "jaxcelt", "simulate", "--omega-pi", "17", "--periods", "1", "--out", str(tmp_path)]
+    subprocess.run(cmd, env=env, check=True, capture_output=True)
+    assert cache.is_dir() and any(cache.iterdir())

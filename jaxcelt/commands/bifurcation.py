@@ -42,6 +42,12 @@ def register(sub) -> None:
     )
     p.add_argument("--width", type=int, default=16, help="pool slots: lanes stepped side by side (vmap width)")
     p.add_argument(
+        "--host-devices",
+        default="auto",
+        help="CPU only: split the CPU into this many JAX devices and shard lanes over them (one XLA CPU "
+        "computation uses about one core); 'auto' = number of CPU cores, 1 = off. Ignored on GPU",
+    )
+    p.add_argument(
         "--stop-on-invalid",
         action=argparse.BooleanOptionalAction,
         default=True,
@@ -81,7 +87,24 @@ def _ranges(ds, key: str = "regime") -> list[dict]:
     return out
 
 
+def _set_host_devices(spec: str) -> int:
+    """Ask JAX for ``spec`` CPU devices (before the backend starts); returns the count asked for."""
+    import os
+
+    import jax
+
+    n = (os.cpu_count() or 1) if spec == "auto" else int(spec)
+    if n < 1:
+        raise SystemExit(f"--host-devices must be >= 1 or 'auto', got {spec!r}")
+    try:
+        jax.config.update("jax_num_cpu_devices", n)
+    except RuntimeError:  # backend already started (e.g. called from Python after JAX work)
+        pass
+    return n
+
+
 def run(args) -> int:
+    _set_host_devices(args.host_devices)
     import numpy as np
 
     import jaxcelt as jc
