@@ -25,7 +25,8 @@ Every cell has a step budget (max_steps) and the script has a wall-time budget p
 whose predicted time exceeds ``--cell-budget`` or that start after ``--part-budget`` are recorded
 as "not run". JSON is rewritten after every cell (``stability_<part>.json``).
 
-    python benchmarks/stability.py [--parts a,b,c,d,e] [--out docs/performance]
+    python benchmarks/stability.py [--quick] [--parts a,b,c,d,e] [--out docs/performance]
+    python benchmarks/stability.py --plot-only      # redraw stability_*.png from the JSON files
 """
 
 from __future__ import annotations
@@ -144,11 +145,13 @@ def _predict(history, max_steps):
 
 
 def part_a(part, args):
-    epss = [1e-2, 1e-4, 1e-6, 1e-8, 1e-10]
+    epss = [1e-2, 1e-4, 1e-6] if args.quick else [1e-2, 1e-4, 1e-6, 1e-8, 1e-10]
     methods = [
         ("Tsit5", 1e-6), ("Dopri8", 1e-6), ("Kvaerno5-chord", 1e-6), ("Kvaerno5-Newton", 1e-6),
         ("Tsit5", 1e-8), ("Kvaerno5-Newton", 1e-8),
     ]  # fmt: skip
+    if args.quick:
+        methods = [("Tsit5", 1e-6), ("Kvaerno5-Newton", 1e-6)]
     if args.a_methods:
         methods = [(m.split(":")[0], float(m.split(":")[1])) for m in args.a_methods.split(",")]
     ms = args.max_steps
@@ -161,7 +164,9 @@ def part_a(part, args):
     for eps in epss:
         sc = bm.make_scene("stick_slip", 1, eps=eps, eps_R=eps)
         ref = {}
-        for rname, rtol, atol in (("Dopri8", 1e-12, 1e-14), ("Kvaerno5-Newton", 1e-9, 1e-11)):
+        for rname, rtol, atol in (("Dopri8", 1e-12, 1e-14), ("Kvaerno5-Newton", 1e-9, 1e-11))[
+            : 2 if args.a_second_ref else 1
+        ]:
             h = hist.setdefault(("ref", rname), [])
             pred = _predict(h, ms)
             if pred > args.cell_budget or part.over:
@@ -177,7 +182,7 @@ def part_a(part, args):
                           accepted=int(sol.num_accepted_steps), rejected=int(sol.num_rejected_steps), run_s=run_s,
                           compile_s=comp, final_omega3=_f(ys[-1, 5])),
                      f"ref eps {eps:.0e} {rname}: status {st} steps {steps} run {run_s:.1f}s")  # fmt: skip
-        a, b = ref["Dopri8"].get("ys"), ref["Kvaerno5-Newton"].get("ys")
+        a, b = ref["Dopri8"].get("ys"), ref.get("Kvaerno5-Newton", {}).get("ys")
         agree = bm.state_error(a, b) if a is not None and b is not None else None
         refs[eps] = dict(ys=a, second=b, agreement=agree)
         part.add(dict(kind="reference_agreement", eps=eps, agreement=agree),
@@ -190,7 +195,11 @@ def part_a(part, args):
             pred = _predict(h, ms)
             label = f"{name} rtol {rtol:.0e}"
             if pred > args.cell_budget or part.over:
-                why = "part budget used" if part.over else f"predicted {pred:.0f} s > cell budget {args.cell_budget:.0f} s"
+                why = (
+                    "part budget used"
+                    if part.over
+                    else f"predicted {pred:.0f} s > cell budget {args.cell_budget:.0f} s"
+                )
                 part.add(dict(kind="cell", method=label, eps=eps, verdict="not run", why=why),
                          f"eps {eps:.0e} {label}: not run ({why})")  # fmt: skip
                 continue
@@ -248,12 +257,14 @@ def _spectral_radius(sc, ts_dense):
 
 def part_b(part, args):
     dts = [1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4, 5e-5, 2e-5, 1e-5, 5e-6, 2e-6]
+    if args.quick:
+        dts = [1e-2, 1e-3, 1e-4, 1e-5]
     ms = 400_000
     scenes = [
         ("rest17, 2 periods", bm.make_scene("rest17", 2)),
         ("stick-slip eps 1e-4", bm.make_scene("stick_slip", 1, eps=1e-4, eps_R=1e-4)),
         ("stick-slip eps 1e-6", bm.make_scene("stick_slip", 1, eps=1e-6, eps_R=1e-6)),
-    ]
+    ][: 2 if args.quick else 3]
     part.set("setup", dict(dts=dts, wrong_tol=WRONG_TOL, reference="Tsit5 rtol 1e-12 atol 1e-14", max_steps=ms))
     for label, sc in scenes:
         _, ys_ref, _, _ = solve(part, sc, "Tsit5", rtol=1e-12, atol=1e-14, max_steps=ms)
@@ -297,19 +308,25 @@ def part_b(part, args):
 def _regime(ys, sol, p):
     r_O = np.asarray(jax.vmap(lambda y: jc.centre_position(y, p))(jnp.asarray(ys)))
     half = ys.shape[0] // 2
-    lab = classify(ys[None, half:], np.array([int(sol.status)]), np.array([bool(sol.valid)]), r_O[None, half:], tol=1e-3)
+    lab = classify(
+        ys[None, half:], np.array([int(sol.status)]), np.array([bool(sol.valid)]), r_O[None, half:], tol=1e-3
+    )
     return str(regime_names(lab["regime"], lab["period"])[0]), int(lab["period"][0])
 
 
 def part_c(part, args):
-    periods = args.c_periods
+    periods = 10 if args.quick else args.c_periods
     part.set("setup", dict(periods=periods, solver="Tsit5", f32="rtol 1e-5 atol 1e-7", f64="rtol 1e-8 atol 1e-10",
                            control="float64 at rtol 1e-5 atol 1e-7", separation=WRONG_TOL,
                            regime="jaxcelt.regimes.classify on the last half of the stroboscopic samples, tol 1e-3, no Lyapunov exponent"))  # fmt: skip
     for w in (14, 17, 19):
         sc = bm.make_scene(f"rest{w}", periods)
         runs = {}
-        for tag, rtol, dtype in (("f64", 1e-8, jnp.float64), ("f32", 1e-5, jnp.float32), ("f64_loose", 1e-5, jnp.float64)):
+        for tag, rtol, dtype in (
+            ("f64", 1e-8, jnp.float64),
+            ("f32", 1e-5, jnp.float32),
+            ("f64_loose", 1e-5, jnp.float64),
+        ):
             sol, ys, run_s, comp = solve(part, sc, "Tsit5", rtol=rtol, dtype=dtype, max_steps=args.max_steps)
             runs[tag] = (sol, ys, run_s)
         sol64, y64, _ = runs["f64"]
@@ -336,7 +353,7 @@ def part_c(part, args):
 
 
 def part_d(part, args):
-    horizons = [1, 2, 4, 8, 16, 32]
+    horizons = [1, 2] if args.quick else [1, 2, 4, 8, 16, 32]
     mu0 = 0.2241
     ms = 100_000
     part.set("setup", dict(horizons_periods=horizons, loss="mean over k = 1..P of |(v, omega)(kT)|^2 [SI]",
@@ -362,7 +379,11 @@ def part_d(part, args):
             ts = jnp.asarray(T * np.arange(1, P + 1))
 
             def loss(mu, p0=p0, y0=y0, ts=ts, P=P, T=T):
-                sol = jc.simulate(p0.replace(mu=mu), y0, P * T, ts=ts, rtol=1e-8, atol=1e-10, exact_ts=True, max_steps=ms)
+                # y0 + 0 mu: a traced y0 makes simulate skip its host-side check_state, which
+                # cannot run when only some parameter leaves (here mu) are traced
+                sol = jc.simulate(
+                    p0.replace(mu=mu), y0 + 0.0 * mu, P * T, ts=ts, rtol=1e-8, atol=1e-10, exact_ts=True, max_steps=ms
+                )
                 return jnp.mean(jnp.sum(sol.ys[:, :6] ** 2, axis=1))
 
             t = time.perf_counter()
@@ -395,12 +416,21 @@ def part_d(part, args):
     p0 = jc.CeltParams.paper(omega_pi=17.0)
     y0 = jc.initial_state(p0)
     T = 2 * np.pi / 17
-    for ms2 in (1_000, 10_000, 100_000, 1_000_000):
+    for ms2 in () if args.quick else (1_000, 10_000, 100_000, 1_000_000):
         if part.over:
             break
 
         def loss2(mu, ms2=ms2):
-            sol = jc.simulate(p0.replace(mu=mu), y0, T, ts=jnp.asarray([T]), rtol=1e-8, atol=1e-10, exact_ts=True, max_steps=ms2)
+            sol = jc.simulate(
+                p0.replace(mu=mu),
+                y0 + 0.0 * mu,
+                T,
+                ts=jnp.asarray([T]),
+                rtol=1e-8,
+                atol=1e-10,
+                exact_ts=True,
+                max_steps=ms2,
+            )
             return jnp.sum(sol.ys[:, :6] ** 2)
 
         t = time.perf_counter()
@@ -423,7 +453,9 @@ def part_e(part, args):
     p = jc.CeltParams.paper(omega_pi=17.0)
     T = 2 * np.pi / 17
     sc = bm.Scene("e", p, np.zeros(13), 0.5 * T, np.linspace(0.0, 0.5 * T, 11), "")
-    part.set("setup", dict(solver="Tsit5 rtol 1e-8", horizon_s=0.5 * T, semi_axes_m=[float(p.a1), float(p.a2), float(p.a3)]))
+    part.set(
+        "setup", dict(solver="Tsit5 rtol 1e-8", horizon_s=0.5 * T, semi_axes_m=[float(p.a1), float(p.a2), float(p.a3)])
+    )
 
     def st_stop(sol):
         return int(sol.status) == 2
@@ -432,7 +464,11 @@ def part_e(part, args):
         s = sc if horizon is None else bm.Scene("e", p, np.zeros(13), horizon, np.linspace(0.0, horizon, 11), "")
         sol, ys, run_s, _ = solve(part, s, "Tsit5", rtol=1e-8, y0=y0, max_steps=20_000, stop_on_invalid=stop)
         # after a stop_on_invalid stop diffrax fills the later samples with inf: not a NaN
-        finite = bool(np.all(np.isfinite(ys[np.asarray(sol.ts) <= float(sol.validity.first_invalid_t)]))) if st_stop(sol) else bool(np.all(np.isfinite(ys)))
+        finite = (
+            bool(np.all(np.isfinite(ys[np.asarray(sol.ts) <= float(sol.validity.first_invalid_t)])))
+            if st_stop(sol)
+            else bool(np.all(np.isfinite(ys)))
+        )
         kind = int(sol.validity.first_invalid_kind)
         st = int(sol.status)
         if st == 2:
@@ -491,8 +527,9 @@ def part_e(part, args):
 
 
 def merged_a_cells(out):
-    """Cells of (a): ``stability_a.json`` with its "not run" cells replaced by the same
-    (method, eps) from ``stability_a_implicit.json`` (the implicit re-run with a larger budget)."""
+    """Cells of (a): ``stability_a.json``, with a (method, eps) cell replaced by the one in
+    ``stability_a_implicit.json`` (the implicit re-run with a larger cell budget and compile time
+    separated) where that one was run."""
     cells = []
     for tag in ("a", "a_implicit"):
         f = out / f"stability_{tag}.json"
@@ -501,7 +538,7 @@ def merged_a_cells(out):
                 if r.get("kind") != "cell":
                     continue
                 old = [c for c in cells if c["method"] == r["method"] and c["eps"] == r["eps"]]
-                if old and old[0]["verdict"] != "not run":
+                if old and r["verdict"] == "not run":
                     continue
                 cells = [c for c in cells if c not in old] + [r]
     order = ["Tsit5 rtol 1e-06", "Tsit5 rtol 1e-08", "Dopri8 rtol 1e-06", "Kvaerno5-chord rtol 1e-06",
@@ -540,7 +577,9 @@ def main(argv=None):
     ap.add_argument("--c-periods", type=int, default=50)
     ap.add_argument("--a-methods", default="", help="(a) only these, e.g. Kvaerno5-Newton:1e-6,Tsit5:1e-6")
     ap.add_argument("--a-no-rest", dest="a_rest", action="store_false", help="(a) skip the from-rest scene")
+    ap.add_argument("--a-no-second-ref", dest="a_second_ref", action="store_false", help="(a) Dopri8 reference only")
     ap.add_argument("--tag", default="", help="suffix of the part name in the JSON file name")
+    ap.add_argument("--quick", action="store_true", help="small version (minutes): files stability_<part>_quick.json")
     ap.add_argument("--plot-only", action="store_true", help="only redraw the PNGs from the JSON files")
     args = ap.parse_args(argv)
     out = pathlib.Path(args.out)
@@ -555,7 +594,7 @@ def main(argv=None):
     print("versions:", info, flush=True)
     fns = dict(a=part_a, b=part_b, c=part_c, d=part_d, e=part_e)
     for name in args.parts.split(","):
-        part = Part(name + args.tag, out, args.part_budget, dict(versions=info))
+        part = Part(name + args.tag + ("_quick" if args.quick else ""), out, args.part_budget, dict(versions=info))
         fns[name](part, args)
         with open("/proc/loadavg") as f:
             part.set("loadavg_at_end", f.read().split()[:3])

@@ -38,6 +38,10 @@ def plot_verdict_grid(rows: list[dict], title: str = "Stability map", slow: floa
                 txt = f"{rr[0]['steps']:,} steps"
                 if rr[0].get("error_vs_ref") is not None:
                     txt += f"\nerr {rr[0]['error_vs_ref']:.0e}"
+                elif rr[0].get("status") == 1:
+                    txt += "\n(max_steps hit)"
+                if rr[0].get("run_s") is not None:
+                    txt += f"\n{rr[0]['run_s']:.3g} s"
                 ax.text(j + 0.5, i + 0.5, txt, ha="center", va="center", fontsize=7)
     ax.set_xlim(0, len(xs))
     ax.set_ylim(0, len(methods))
@@ -47,7 +51,7 @@ def plot_verdict_grid(rows: list[dict], title: str = "Stability map", slow: floa
     ax.set_xlabel("friction smoothing eps = eps_R [s^-2]")
     handles = [plt.Rectangle((0, 0), 1, 1, color=c) for c in VERDICT_COLOR.values()]
     ax.legend(handles, list(VERDICT_COLOR), ncol=6, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.18))
-    sub = "cell: steps per period (accepted + rejected), max error vs eps-specific reference"
+    sub = "cell: steps per period (accepted + rejected), max error vs eps-specific reference, run time (loaded CPU)"
     if slow is not None:
         sub += f"; slow = > {slow:,.0f} steps"
     ax.set_title(f"{title}\n({sub})", fontsize=9)
@@ -72,7 +76,15 @@ def plot_dt_scan(rows: list[dict], wrong_tol: float = 1e-2):
             ok = ~blow & np.isfinite(err)
             ax.loglog(dt[ok], err[ok], "o-", color=c, ms=4, label=name.replace("-fixed", ""))
             if blow.any():
-                ax.loglog(dt[blow], np.full(blow.sum(), top), "x", color=c, ms=8, mew=2, label=f"{name.replace('-fixed', '')} blow-up")
+                ax.loglog(
+                    dt[blow],
+                    np.full(blow.sum(), top),
+                    "x",
+                    color=c,
+                    ms=8,
+                    mew=2,
+                    label=f"{name.replace('-fixed', '')} blow-up",
+                )
             lim = sc["dt_limit_RK4"] if name.startswith("RK4") else sc["dt_limit_Heun"]
             ax.axvline(lim, color=c, ls="--", lw=1, label=f"{name.replace('-fixed', '')} limit {lim:.1e} s")
         ax.axhline(wrong_tol, color="k", ls=":", lw=1, label=f"wrong (> {wrong_tol:g})")
@@ -81,7 +93,9 @@ def plot_dt_scan(rows: list[dict], wrong_tol: float = 1e-2):
         ax.set_ylabel("max |y - y_ref| over samples [SI]")
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=6.5, loc="lower right")
-    fig.suptitle("(b) fixed-step error against dt (x at top: NaN/inf, status != 0 or validity monitor fired)", fontsize=10)
+    fig.suptitle(
+        "(b) fixed-step error against dt (x at top: NaN/inf, status != 0 or validity monitor fired)", fontsize=10
+    )
     fig.tight_layout()
     return fig
 
@@ -96,7 +110,9 @@ def plot_float32_separation(rows: list[dict], sep_tol: float = 1e-2):
         for r in [r for r in rows if r["omega_pi"] == w]:
             lab, c = style[r["run"]]
             d = np.maximum(np.asarray(r["err_per_period"], float), 1e-16)
-            ax.semilogy(np.arange(len(d)), d, "-", color=c, label=f"{lab}: {r['regime']} (f64 rtol 1e-8: {r['regime_f64']})")
+            ax.semilogy(
+                np.arange(len(d)), d, "-", color=c, label=f"{lab}: {r['regime']} (f64 rtol 1e-8: {r['regime_f64']})"
+            )
         ax.axhline(sep_tol, color="k", ls=":", lw=1, label=f"separated ({sep_tol:g})")
         ax.set_title(f"from rest, omega_pi = {w} rad/s", fontsize=9)
         ax.set_xlabel("time [base periods]")
@@ -131,7 +147,14 @@ def plot_gradient_horizon(rows: list[dict]):
                         label=f"omega_pi = {w}: tangent growth (lambda = {ly[w]['exponent']:.2f} 1/s), scaled")  # fmt: skip
         a2.semilogy(P, [r["grad_run_s"] for r in rr], "o-", color=c, label=f"omega_pi = {w}: grad run time [s]")
         a2.semilogy(P, [r["fwd_run_s"] for r in rr], "s:", color=c, ms=4, label=f"omega_pi = {w}: forward run time [s]")
-        a2.semilogy(P, [max(r["temp_MB"], 1e-3) for r in rr], "^--", color=c, ms=5, label=f"omega_pi = {w}: compiled temp memory [MB]")
+        a2.semilogy(
+            P,
+            [max(r["temp_MB"], 1e-3) for r in rr],
+            "^--",
+            color=c,
+            ms=5,
+            label=f"omega_pi = {w}: compiled temp memory [MB]",
+        )
     a1.set_xlabel("horizon [base periods]")
     a1.set_ylabel("|d loss / d mu| [SI]")
     a1.set_title("(d) gradient norm against horizon", fontsize=10)
