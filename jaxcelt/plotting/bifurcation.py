@@ -18,7 +18,26 @@ REGIME_COLOURS = {
 }
 
 
-def bifurcation_figure(ds, *, color_by: str = "regime", component: str = "omega2", title: str = ""):
+def _lyapunov_bins(lam: np.ndarray, band: float):
+    """Discrete colour bins for Lyapunov exponents (BoundaryNorm): strong colours everywhere."""
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+
+    inner = [-0.5, -band, band, 0.3, 0.6, 1.0]
+    lo = min(-1.0, float(np.nanmin(lam)) - 1e-9) if np.isfinite(lam).any() else -1.0
+    hi = max(1.5, float(np.nanmax(lam)) + 1e-9) if np.isfinite(lam).any() else 1.5
+    bounds = [lo, *inner, hi]
+    colours = ["#08306b", "#4292c6", "#737373", "#fdae61", "#f46d43", "#d73027", "#67000d"]
+    return ListedColormap(colours), BoundaryNorm(bounds, len(colours)), bounds
+
+
+def bifurcation_figure(
+    ds,
+    *,
+    color_by: str = "regime",
+    component: str = "omega2",
+    title: str = "",
+    lyapunov_band: float = 0.02,
+):
     """Fig. 3-style diagram from a sweep dataset (`jaxcelt.dataset.to_dataset`/`open_sweep`).
 
     Args:
@@ -26,13 +45,16 @@ def bifurcation_figure(ds, *, color_by: str = "regime", component: str = "omega2
             ``period``, ``global_motion``, ``lyapunov``.
         color_by: ``"regime"`` (periodic / quasi-periodic / chaotic / invalid / failed;
             unbounded global motion drawn with hollow markers in a strip below) or
-            ``"lyapunov"`` (largest exponent [1/s], diverging colour map centred at 0).
+            ``"lyapunov"`` (largest exponent [1/s] in discrete bins: blues below
+            ``-lyapunov_band``, grey within +-``lyapunov_band`` (neutral: quasi-periodic or
+            not converged), oranges to dark red above -- no pale colours near 0).
+        lyapunov_band: half-width of the neutral bin [1/s] (default: `classify_regimes`'
+            chaos threshold).
         component: state component plotted (``"omega2"`` as in the paper).
 
     Returns the matplotlib Figure.
     """
     import matplotlib.pyplot as plt
-    from matplotlib.colors import TwoSlopeNorm
     from matplotlib.lines import Line2D
 
     from ..regimes import REGIMES
@@ -64,18 +86,14 @@ def bifurcation_figure(ds, *, color_by: str = "regime", component: str = "omega2
     if color_by == "lyapunov":
         lam = lyap[ok]
         fin = np.isfinite(lam)
-        vmax = max(np.nanmax(np.abs(lam)) if fin.any() else 1.0, 1e-3)
-        sc = ax.scatter(
-            x[ok][fin],
-            sec[ok][fin],
-            c=lam[fin],
-            s=ms,
-            cmap="coolwarm",
-            norm=TwoSlopeNorm(0.0, -vmax, vmax),
-            linewidths=0,
-        )
-        ax.scatter(x[ok][~fin], sec[ok][~fin], s=ms, color="0.6", linewidths=0)
-        fig.colorbar(sc, ax=ax, label=r"largest Lyapunov exponent $\lambda_1$ [1/s]", pad=0.01)
+        cmap, norm, bounds = _lyapunov_bins(lam, lyapunov_band)
+        sc = ax.scatter(x[ok][fin], sec[ok][fin], c=lam[fin], s=ms, cmap=cmap, norm=norm, linewidths=0)
+        if (~fin).any():
+            ax.scatter(x[ok][~fin], sec[ok][~fin], s=ms, color="#d9d9d9", linewidths=0, label="no exponent")
+            ax.legend(loc="upper left", fontsize=8, markerscale=3)
+        cb = fig.colorbar(sc, ax=ax, label=r"largest Lyapunov exponent $\lambda_1$ [1/s]", pad=0.01, spacing="uniform")
+        cb.set_ticks(bounds)
+        cb.set_ticklabels([f"{b:.2g}" for b in bounds])
     else:
         handles = []
         for code, label in REGIMES.items():
@@ -98,8 +116,9 @@ def bifurcation_figure(ds, *, color_by: str = "regime", component: str = "omega2
             Line2D([], [], ls="", marker="s", color="tab:cyan", label="bounded"),
             Line2D([], [], ls="", marker="s", color="tab:orange", label="unbounded wandering"),
         ],
-        loc="center left",
-        bbox_to_anchor=(1.0, 0.5),
+        loc="upper right",
+        bbox_to_anchor=(1.0, -0.9),
+        ncol=2,
         fontsize=8,
         frameon=False,
     )
