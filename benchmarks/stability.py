@@ -529,7 +529,7 @@ def part_e(part, args):
 def merged_a_cells(out):
     """Cells of (a): ``stability_a.json``, with a (method, eps) cell replaced by the one in
     ``stability_a_implicit.json`` (the implicit re-run with a larger cell budget and compile time
-    separated) where that one was run."""
+    separated) where that file has it."""
     cells = []
     for tag in ("a", "a_implicit"):
         f = out / f"stability_{tag}.json"
@@ -538,8 +538,6 @@ def merged_a_cells(out):
                 if r.get("kind") != "cell":
                     continue
                 old = [c for c in cells if c["method"] == r["method"] and c["eps"] == r["eps"]]
-                if old and r["verdict"] == "not run":
-                    continue
                 cells = [c for c in cells if c not in old] + [r]
     order = ["Tsit5 rtol 1e-06", "Tsit5 rtol 1e-08", "Dopri8 rtol 1e-06", "Kvaerno5-chord rtol 1e-06",
              "Kvaerno5-Newton rtol 1e-06", "Kvaerno5-Newton rtol 1e-08"]  # fmt: skip
