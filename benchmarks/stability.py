@@ -150,6 +150,8 @@ def part_a(part, args):
         ("Tsit5", 1e-6), ("Dopri8", 1e-6), ("Kvaerno5-chord", 1e-6), ("Kvaerno5-Newton", 1e-6),
         ("Tsit5", 1e-8), ("Kvaerno5-Newton", 1e-8),
     ]  # fmt: skip
+    if args.a_eps:
+        epss = [float(e) for e in args.a_eps.split(",")]
     if args.quick:
         methods = [("Tsit5", 1e-6), ("Kvaerno5-Newton", 1e-6)]
     if args.a_methods:
@@ -529,9 +531,10 @@ def part_e(part, args):
 def merged_a_cells(out):
     """Cells of (a): ``stability_a.json``, with a (method, eps) cell replaced by the one in
     ``stability_a_implicit.json`` (the implicit re-run with a larger cell budget and compile time
-    separated) where that file has it."""
+    separated) where that file has it, and then by ``stability_a_eps1e-10.json`` (eps = 1e-10 with a
+    larger step budget for the reference)."""
     cells = []
-    for tag in ("a", "a_implicit"):
+    for tag in ("a", "a_implicit", "a_eps1e-10"):
         f = out / f"stability_{tag}.json"
         if f.exists():
             for r in json.loads(f.read_text())["rows"]:
@@ -575,6 +578,7 @@ def main(argv=None):
     ap.add_argument("--c-periods", type=int, default=50)
     ap.add_argument("--a-methods", default="", help="(a) only these, e.g. Kvaerno5-Newton:1e-6,Tsit5:1e-6")
     ap.add_argument("--a-no-rest", dest="a_rest", action="store_false", help="(a) skip the from-rest scene")
+    ap.add_argument("--a-eps", default="", help="(a) only these eps, e.g. 1e-10")
     ap.add_argument("--a-no-second-ref", dest="a_second_ref", action="store_false", help="(a) Dopri8 reference only")
     ap.add_argument("--tag", default="", help="suffix of the part name in the JSON file name")
     ap.add_argument("--quick", action="store_true", help="small version (minutes): files stability_<part>_quick.json")
