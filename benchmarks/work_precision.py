@@ -260,11 +260,16 @@ def main(argv=None):
         default=None,
         help="scenes (in order) of the scenes part; 'a,b;c' = groups for repeated scenes parts",
     )
+    ap.add_argument("--periods", default=None, help="override periods per scene, e.g. 'spin_reversal=10'")
+    ap.add_argument("--solvers", default=None, help="comma list: run only these methods")
     ap.add_argument("--fresh", action="store_true", help="ignore an existing JSON (default: resume)")
     ap.add_argument("--plot-only", action="store_true", help="only redraw the charts from the JSON")
     ap.add_argument("--report", action="store_true", help="print Markdown tables from the JSON and exit")
     args = ap.parse_args(argv)
     cfg = config(args.quick)
+    if args.periods:
+        over = {k: int(v) for k, v in (kv.split("=") for kv in args.periods.split(","))}
+        cfg["scenes"] = [(n, over.get(n, p)) for n, p in cfg["scenes"]]
     parts = args.parts.split(",")
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -314,7 +319,7 @@ def main(argv=None):
         return e
 
     def run_ladder(lkey, lst, key, val, extra, scene_name, periods, solver, values, law=None, dtype=None):
-        if lkey in res["done"] or args.plot_only:
+        if lkey in res["done"] or args.plot_only or (args.solvers and solver not in args.solvers.split(",")):
             return
         if out_of_time():
             print(f"deadline: skipping {lkey}", flush=True)
