@@ -287,9 +287,10 @@ def main(argv=None):
     else:
         res = dict(scenes=[], float32=[], laws=[], done=[], references={})
     res["config"] = {k: v for k, v in cfg.items()}
-    res.setdefault("sessions", []).append(
-        dict(versions=info, started=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()))
-    )
+    if not args.plot_only:
+        res.setdefault("sessions", []).append(
+            dict(versions=info, started=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()))
+        )
     res["versions"] = info
     t_start = time.perf_counter()
     refs: dict = {}
@@ -395,9 +396,10 @@ def main(argv=None):
                         break
         else:
             raise ValueError(f"unknown part {part!r}")
-    res["total_seconds_last_session"] = time.perf_counter() - t_start
-    save()
-    print("wrote", path, f"({res['total_seconds_last_session']:.0f} s)", flush=True)
+    if not args.plot_only:
+        res["total_seconds_last_session"] = time.perf_counter() - t_start
+        save()
+    print("wrote", path, f"({res.get('total_seconds_last_session', 0):.0f} s)", flush=True)
     from jaxcelt.plotting.performance import plot_work_precision
 
     for fig_name, fig in plot_work_precision(res).items():
