@@ -130,11 +130,21 @@ def test_must_show_1_recovery(kinds):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("optimiser", ["lbfgs", "adam", "gn", "gn-damped"])
+@pytest.mark.parametrize("optimiser", ["lbfgs", "adam", "gn-damped"])
 def test_other_optimisers_reduce_loss(short_imu, optimiser):
-    res = jc.fit(short_imu.subset(["omega"]), PAPER, free=FREE, optimiser=optimiser, max_iter=40)
+    res = jc.fit(short_imu.subset(["omega"]), PAPER, free=FREE, optimiser=optimiser, max_iter=40, max_steps=20_000)
     # all must make progress on the same problem; only LM/GN are expected to converge tightly
     assert res.loss_history[-1] < 0.1 * res.loss_history[0]
+
+
+@pytest.mark.slow
+def test_plain_gauss_newton_diverges_gracefully(short_imu):
+    """Plain Gauss-Newton (full steps) is not expected to make progress from this start: its first
+    steps take b_Ts to ~1e9 and then to inf (measured; docs/identification.md section 4), which is
+    why ``gn-damped`` exists. The fit must still return (no exception), unconverged."""
+    res = jc.fit(short_imu.subset(["omega"]), PAPER, free=FREE, optimiser="gn", max_iter=3, max_steps=20_000)
+    assert not res.converged
+    assert not res.loss_history[-1] < 0.1 * res.loss_history[0]
 
 
 @pytest.mark.slow
