@@ -111,8 +111,8 @@ def check_state(y: ArrayLike, params: CeltParams, *, name: str = "y0", tol: floa
         bad = np.argwhere(~np.isfinite(arr.reshape(-1, 13)))[0]
         raise ValueError(f"{name!r} contains NaN/inf (first at component {bad[-1]})")
     flat = arr.reshape(-1, 13)
-    if isinstance(params.m, jax.core.Tracer):
-        return
+    if any(isinstance(x, jax.core.Tracer) for x in jax.tree_util.tree_leaves(params)):
+        return  # e.g. jit(grad) with respect to mu only: the manifold check needs concrete values
     pb = params if np.ndim(params.m) == 0 else None
     for i, yi in enumerate(flat):
         p = (

@@ -142,3 +142,17 @@ def test_grad_with_implicit_solver():
     g_exp = np.asarray(jax.grad(loss)(th, diffrax.Tsit5()))
     assert np.all(np.isfinite(g_imp))
     np.testing.assert_allclose(g_imp, g_exp, rtol=1e-5)
+
+
+def test_grad_wrt_one_traced_leaf_under_jit(paper_params):
+    # only mu traced (params rebuilt inside the jitted function): state checks must not try
+    # to concretise the traced leaf (found by the stability study, part d)
+    y0 = jc.initial_state(paper_params)
+
+    @jax.jit
+    def loss(mu):
+        sol = jc.simulate(paper_params.replace(mu=mu), y0, 0.05, ts=jnp.linspace(0.01, 0.05, 5))
+        return jnp.sum(sol.ys[:, 3:6] ** 2)
+
+    g = jax.grad(loss)(paper_params.mu)
+    assert np.isfinite(g)
