@@ -12,4 +12,6 @@ $PY benchmarks/reference.py $FLAG --out "$OUT"
 $PY benchmarks/work_precision.py $FLAG --out "$OUT"
 $PY benchmarks/stability.py $FLAG --out "$OUT"
 $PY benchmarks/peers.py $FLAG --out "$OUT"
+# MuJoCo / MJX peer (needs the bench extra: pip install -e ".[bench]"); a different contact model
+if $PY -c "import mujoco" 2>/dev/null; then $PY benchmarks/mujoco_peer.py --out "$OUT"; else echo "mujoco not installed: skipped"; fi
 echo "done: results in $OUT"
