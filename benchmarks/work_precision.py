@@ -5,7 +5,8 @@ methods over tolerance / dt ladders; float64 and float32; every contact law in j
 Reference per scene (and per contact law): diffrax Dopri8 at rtol = atol = 1e-13 (validated
 against scipy DOP853 on an independent numba RHS by ``benchmarks/reference.py``). Error: max
 |y - y_ref| over the sample times and the 13 state components (SI units). RHS evaluations: exact
-count for implicit methods (counting contact law, Jacobian columns included), steps x stages for
+count of vector-field calls for implicit methods (counting contact law; the Jacobian's batched
+columns are not included, so implicit points understate their work), steps x stages for
 explicit and fixed-step ones.
 
 Incremental and resumable: the JSON is rewritten after every ladder (one method on one scene),

@@ -14,8 +14,10 @@ from `jaxcelt.simulate` (or from a peer integrator calling the same right-hand s
 * `RK4`, `FixedStep`: the classical 4th-order Runge-Kutta method for diffrax (diffrax ships none)
   and a wrapper that makes any diffrax Runge-Kutta method take constant steps (diffrax's Heun,
   Ralston and Midpoint carry an error estimate, so `simulate` would otherwise step adaptively).
-* `count_rhs_evals`: exact number of right-hand-side evaluations of a solve, Jacobian columns
-  included, via a counting contact law.
+* `count_rhs_evals`: number of right-hand-side calls of a solve via a counting contact law. For
+  implicit solvers this does *not* include the forward-mode Jacobian's columns (jax.jacfwd
+  evaluates them as one batched call, which the host-side counter sees once), so it understates
+  their work: compare implicit methods by run time.
 """
 
 from __future__ import annotations
@@ -281,7 +283,8 @@ class CountingLaw(AbstractContactLaw):
 
 
 def count_rhs_evals(scene: Scene, solver, *, rtol=1e-8, atol=1e-10, dt0=None, law=None, dtype=None, max_steps=200_000):
-    """Right-hand-side evaluations of one solve (Jacobian columns of implicit solvers included).
+    """Right-hand-side calls of one solve (for implicit solvers: Jacobian columns not included --
+    a batched jacfwd call is seen once; see the module docstring).
 
     Counts contact-law calls and subtracts the validity monitor's one per step (+1 at init).
     """
