@@ -44,7 +44,7 @@ def _cross(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
-@nb.njit(fastmath=False, cache=True)
+@nb.njit(fastmath=False, cache=True, error_model="numpy")  # x/0 -> inf/nan as in JAX, no exception
 def rhs(t, y, P, B, Bi, out):
     v0, v1, v2, w0, w1, w2, n0, n1, n2, psi = y[0], y[1], y[2], y[3], y[4], y[5], y[6], y[7], y[8], y[12]
     # contact geometry (eqs. 3-4)
@@ -164,7 +164,7 @@ _B5 = _A[6].copy()
 _E = _B5 - np.array([5179 / 57600, 0, 7571 / 16695, 393 / 640, -92097 / 339200, 187 / 2100, 1 / 40])
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def _dopri_lane(y0, t0, ts, P, B, Bi, rtol, atol, max_steps, out_ys, C, A, B5, E, stop_invalid=False):
     """Integrate one lane, stepping exactly onto each ts[j]; returns (steps, rhs_evals, status).
 
@@ -214,6 +214,8 @@ def _dopri_lane(y0, t0, ts, P, B, Bi, rtol, atol, max_steps, out_ys, C, A, B5, E
             err += (e / sc) ** 2
         err = math.sqrt(err / n)
         steps += 1
+        if err != err:
+            return steps, evals, 3  # NaN/inf state (an invalid lane integrated on into a singularity)
         if err <= 1.0:
             t = tn if hit else t + hh
             for i in range(n):

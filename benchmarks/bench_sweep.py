@@ -178,7 +178,7 @@ def eval_costs(p, vals, width, reps=2000):
 
 def _numba_ensemble(Y0, TS, PP, B, Bi, a, stop):
     t = time.perf_counter()
-    _, st, ev, status = nm.dopri_ensemble(Y0, TS, PP, B, Bi, a.rtol, a.atol, 10**7, stop)
+    _, st, ev, status = nm.dopri_ensemble(Y0, TS, PP, B, Bi, a.rtol, a.atol, 10**6, stop)  # = jaxcelt max_steps
     t_nb = time.perf_counter() - t
     th = nm.nb.get_num_threads()
     return dict(
