@@ -38,9 +38,14 @@ def register(sub) -> None:
     p.add_argument("--atol", type=float, default=1e-10)
     p.add_argument("--max-steps", type=int, default=1_000_000)
     p.add_argument(
-        "--chunk-size", type=int, default=32, help="lanes per jitted pool launch (the unit of resumable writing)"
+        "--chunk-size",
+        type=int,
+        default=200,
+        help="lanes per jitted pool launch (the unit of resumable writing); split over the devices",
     )
-    p.add_argument("--width", type=int, default=16, help="pool slots: lanes stepped side by side (vmap width)")
+    p.add_argument(
+        "--width", type=int, default=32, help="pool slots per device: lanes stepped side by side (vmap width)"
+    )
     p.add_argument(
         "--host-devices",
         default="auto",
@@ -152,6 +157,9 @@ def run(args) -> int:
         "rtol": args.rtol,
         "atol": args.atol,
         "stop_on_invalid": bool(args.stop_on_invalid),
+        "devices": [str(d) for d in __import__("jax").local_devices()],
+        "chunk_size": args.chunk_size,
+        "width_per_device": args.width,
         "wall_seconds_including_compile": round(wall, 2),
         "lanes_failed": int(np.sum(np.isin(ds["status"].values, (1, 3)))),  # status 2 = stopped invalid
         "lanes_invalid": int(np.sum(ds["valid"].values == 0)),
