@@ -110,6 +110,7 @@ def _set_host_devices(spec: str) -> int:
 
 def run(args) -> int:
     _set_host_devices(args.host_devices)
+    import jax
     import numpy as np
 
     import jaxcelt as jc
@@ -157,7 +158,7 @@ def run(args) -> int:
         "rtol": args.rtol,
         "atol": args.atol,
         "stop_on_invalid": bool(args.stop_on_invalid),
-        "devices": [str(d) for d in __import__("jax").local_devices()],
+        "devices": [str(d) for d in jax.local_devices()],
         "chunk_size": args.chunk_size,
         "width_per_device": args.width,
         "wall_seconds_including_compile": round(wall, 2),
