@@ -529,25 +529,8 @@ def part_e(part, args):
 
 
 def merged_a_cells(out):
-    """Cells of (a): ``stability_a.json``, with a (method, eps) cell replaced by the one in
-    ``stability_a_implicit.json`` (the implicit re-run with a larger cell budget and compile time
-    separated) where that file has it, and then, only where the cell was unverified or not run, by
-    ``stability_a_eps1e-10.json`` (eps = 1e-10 with a 3e6-step budget, which lets the reference
-    finish; explicit cells keep their 3e5-step verdict so the map has one budget)."""
-    cells = []
-    for tag in ("a", "a_implicit", "a_eps1e-10"):
-        f = out / f"stability_{tag}.json"
-        if f.exists():
-            for r in json.loads(f.read_text())["rows"]:
-                if r.get("kind") != "cell":
-                    continue
-                old = [c for c in cells if c["method"] == r["method"] and c["eps"] == r["eps"]]
-                if tag == "a_eps1e-10" and old and old[0]["verdict"] not in ("unverified", "not run"):
-                    continue
-                cells = [c for c in cells if c not in old] + [r]
-    order = ["Tsit5 rtol 1e-06", "Tsit5 rtol 1e-08", "Dopri8 rtol 1e-06", "Kvaerno5-chord rtol 1e-06",
-             "Kvaerno5-Newton rtol 1e-06", "Kvaerno5-Newton rtol 1e-08"]  # fmt: skip
-    return sorted(cells, key=lambda r: (order.index(r["method"]) if r["method"] in order else 99, -r["eps"]))
+    """Cells of (a) with the re-runs merged in (`jaxcelt.benchmarking.stability_results`)."""
+    return bm.stability_results(out).get("a", [])
 
 
 def plot_all(out, slow):

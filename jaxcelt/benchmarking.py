@@ -363,17 +363,68 @@ def run_diffrax(
 # reading results back (docs and notebook)
 
 
+_A_ORDER = [
+    "Tsit5 rtol 1e-06",
+    "Tsit5 rtol 1e-08",
+    "Dopri8 rtol 1e-06",
+    "Kvaerno5-chord rtol 1e-06",
+    "Kvaerno5-Newton rtol 1e-06",
+    "Kvaerno5-Newton rtol 1e-08",
+]
+
+
+def stability_results(folder: str = "docs/performance") -> dict[str, list[dict]]:
+    """Rows of the stability study (``benchmarks/stability.py``), one list per part a-e.
+
+    Part (a) merges ``stability_a.json`` with the re-runs: a (method, eps) cell is replaced by
+    the one in ``stability_a_implicit.json`` (implicit re-run with a larger budget) where that
+    file has it, then -- only where the cell was unverified or not run -- by
+    ``stability_a_eps1e-10.json`` (eps = 1e-10 with a 3e6-step budget, which lets the reference
+    finish; explicit cells keep their 3e5-step verdict so the map has one budget).
+    """
+    import json
+    import pathlib
+
+    out: dict[str, list[dict]] = {}
+    folder = pathlib.Path(folder)
+    cells: list[dict] = []
+    for tag in ("a", "a_implicit", "a_eps1e-10"):
+        f = folder / f"stability_{tag}.json"
+        if not f.exists():
+            continue
+        for r in json.loads(f.read_text())["rows"]:
+            if r.get("kind") != "cell":
+                continue
+            old = [c for c in cells if c["method"] == r["method"] and c["eps"] == r["eps"]]
+            if tag == "a_eps1e-10" and old and old[0]["verdict"] not in ("unverified", "not run"):
+                continue
+            cells = [c for c in cells if c not in old] + [r]
+    if cells:
+        key = lambda r: (_A_ORDER.index(r["method"]) if r["method"] in _A_ORDER else 99, -r["eps"])  # noqa: E731
+        out["a"] = sorted(cells, key=key)
+    for part in ("b", "c", "d", "e"):
+        f = folder / f"stability_{part}.json"
+        if f.exists():
+            out[part] = json.loads(f.read_text())["rows"]
+    return out
+
+
 def load_results(folder: str = "docs/performance", quick: bool = False) -> dict[str, Any]:
-    """The JSON files written by ``benchmarks/*.py`` (missing ones are left out)."""
+    """The JSON files written by ``benchmarks/*.py`` (missing ones are left out); the stability
+    study's per-part files come back as ``["stability"]`` = `stability_results` (full size only)."""
     import json
     import pathlib
 
     tag = "_quick" if quick else ""
     out = {}
-    for name in ("reference", "work_precision", "stability", "peers"):
+    for name in ("reference", "work_precision", "peers"):
         f = pathlib.Path(folder) / f"{name}{tag}.json"
         if f.exists():
             out[name] = json.loads(f.read_text())
+    if not quick:
+        st = stability_results(folder)
+        if st:
+            out["stability"] = st
     return out
 
 

@@ -66,8 +66,12 @@ def limits():
     out = {}
     for w in (0.5, 2.0, -3.0):
         out[f"pure spin M_s(w={w}) - 4ES2 sign w"] = float(f(0.0, 0.0, w, B)[2]) - 4 * E * S2 * np.sign(w)
-        out[f"dT_sx/dv_sx(w={w}) - 4GS0/|w|"] = float(jax.grad(lambda v, w=w: f(v, 0.0, w, B)[0])(0.0)) - 4 * G * S0 / abs(w)
-        out[f"dT_sy/dv_sy(w={w}) - 4HS0/|w|"] = float(jax.grad(lambda v, w=w: f(0.0, v, w, B)[1])(0.0)) - 4 * H * S0 / abs(w)
+        out[f"dT_sx/dv_sx(w={w}) - 4GS0/|w|"] = float(
+            jax.grad(lambda v, w=w: f(v, 0.0, w, B)[0])(0.0)
+        ) - 4 * G * S0 / abs(w)
+        out[f"dT_sy/dv_sy(w={w}) - 4HS0/|w|"] = float(
+            jax.grad(lambda v, w=w: f(0.0, v, w, B)[1])(0.0)
+        ) - 4 * H * S0 / abs(w)
     for beta in (0.0, 1.0, 2.5):
         T = f(np.cos(beta), np.sin(beta), 0.0, B)
         out[f"pure sliding |T - v/|v||, beta={beta}"] = float(np.hypot(T[0] - np.cos(beta), T[1] - np.sin(beta)))

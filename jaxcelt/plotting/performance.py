@@ -17,7 +17,6 @@ __all__ = [
     "plot_work_precision_scene",
     "plot_work_precision_float32",
     "plot_work_precision_laws",
-    "plot_stability_map",
     "plot_peers",
 ]
 
@@ -194,48 +193,6 @@ def plot_work_precision(res: dict) -> dict:
     if any(L.get("runs") for L in res.get("laws", [])):
         figs["laws"] = plot_work_precision_laws(res)
     return figs
-
-
-_STATE_COLOR = {
-    "ok": "#4caf50",
-    "slow": "#ffc107",
-    "failed": "#e53935",
-    "wrong attractor": "#8e24aa",
-    "not run": "#bdbdbd",
-}
-
-
-def plot_stability_map(rows: list[dict], x_key: str = "eps", title: str = "Stability map"):
-    """Coloured grid: rows = method (+tolerance), columns = ``x_key`` values; cell text = steps."""
-    methods = list(dict.fromkeys(r["method"] for r in rows))
-    xs = sorted({r[x_key] for r in rows}, reverse=True)
-    fig, ax = plt.subplots(figsize=(max(8.0, 1.15 * len(xs) + 3.5), 0.45 * len(methods) + 2.0))
-    for i, m in enumerate(methods):
-        for j, x in enumerate(xs):
-            rr = [r for r in rows if r["method"] == m and r[x_key] == x]
-            state = rr[0]["verdict"] if rr else "not run"
-            ax.add_patch(plt.Rectangle((j, i), 1, 1, color=_STATE_COLOR[state], ec="w"))
-            if rr:
-                txt = f"{rr[0].get('steps', 0):.0f}" if rr[0].get("steps") is not None else ""
-                ax.text(j + 0.5, i + 0.5, txt, ha="center", va="center", fontsize=7)
-    ax.set_xlim(0, len(xs))
-    ax.set_ylim(0, len(methods))
-    ax.set_xticks(np.arange(len(xs)) + 0.5, [f"{x:.0e}" if isinstance(x, float) else str(x) for x in xs], fontsize=8)
-    ax.set_yticks(np.arange(len(methods)) + 0.5, methods, fontsize=8)
-    ax.invert_yaxis()
-    ax.set_xlabel(x_key)
-    handles = [plt.Rectangle((0, 0), 1, 1, color=c) for c in _STATE_COLOR.values()]
-    ax.legend(
-        handles,
-        list(_STATE_COLOR),
-        ncol=5,
-        fontsize=7,
-        loc="upper center",
-        bbox_to_anchor=(0.5, -0.12 - 0.2 / max(len(methods), 1)),
-    )
-    ax.set_title(title + "\n(cell text: steps, accepted + rejected)", fontsize=10)
-    fig.tight_layout()
-    return fig
 
 
 def plot_peers(rows: list[dict], scaling: list[dict] | None = None):
