@@ -265,16 +265,21 @@ def rhs_loop(y, P, B, Bi, n):
 # f(t, y) wrappers for scipy, and the agreement check against jaxcelt
 
 
-def numba_rhs(p):
-    """``f(t, y) -> dy/dt`` (a fresh array per call, as scipy expects) over the compiled `rhs`."""
+def _scipy_f(kernel, p):
+    """``f(t, y) -> dy/dt`` over ``kernel(t, y, P, B, Bi, out)`` (a fresh array per call, as scipy expects)."""
     P, B, Bi = pack(p)
 
     def f(t, y):
         out = np.empty(13)
-        rhs(float(t), np.ascontiguousarray(y, dtype=np.float64), P, B, Bi, out)
+        kernel(float(t), np.ascontiguousarray(y, dtype=np.float64), P, B, Bi, out)
         return out
 
     return f
+
+
+def numba_rhs(p):
+    """``f(t, y) -> dy/dt`` over the compiled `rhs`."""
+    return _scipy_f(rhs, p)
 
 
 def _interpreted(fn, **globals_):
@@ -290,14 +295,7 @@ _rhs_py = _interpreted(rhs, _cross=_cross.py_func)
 
 def python_rhs(p):
     """``f(t, y) -> dy/dt``: the source of `rhs` run by the Python interpreter (nothing compiled)."""
-    P, B, Bi = pack(p)
-
-    def f(t, y):
-        out = np.empty(13)
-        _rhs_py(float(t), np.asarray(y, dtype=np.float64), P, B, Bi, out)
-        return out
-
-    return f
+    return _scipy_f(_rhs_py, p)
 
 
 def ensemble(Y0, ts, p, rtol, atol, max_steps=10**7):

@@ -1,14 +1,17 @@
 """Where a sweep step's time goes: per-lane cost of one vector-field evaluation, the validity
 monitor, a bare diffrax Tsit5 step (6 RHS + RK bookkeeping), the monitored step, and the lane
-pool's full step (controller, clipping, selects), each vmapped over W lanes inside one jitted
-loop (no dispatch), best of 5. One JAX device.
+pool's full step (controller, clipping, selects), each vmapped over the lanes inside one
+jitted loop (no dispatch), best of 5. One JAX device. `step_parts` is also what
+``bench_sweep.py`` uses for its per-evaluation costs.
 
-    .venv/bin/python benchmarks/bench_step_parts.py [W] [n_sample_times] [--out docs/bifurcation]
+    .venv/bin/python benchmarks/bench_step_parts.py [--width 32] [--samples 100] [--out docs/bifurcation]
 """
 
+from __future__ import annotations
+
+import argparse
 import json
 import os
-import sys
 import time
 from pathlib import Path
 
@@ -22,92 +25,90 @@ from jaxcelt.model import vector_field
 from jaxcelt.solve import _invalid_kind
 from jaxcelt.sweep import SweepConfig, _lane_init, _lane_step, _pool_parts, lanes_params
 
-p = jc.CeltParams.paper()
-args = [x for x in sys.argv[1:] if not x.startswith("--")]
-OUT = Path(sys.argv[sys.argv.index("--out") + 1]) if "--out" in sys.argv else None
-if OUT is not None:
-    args = [x for x in args if x != str(OUT)]
-W = int(args[0]) if len(args) > 0 else 32
-reps = 2000
-NS = int(args[1]) if len(args) > 1 else 100
-RES = {"versions": None, "width": W, "load_average_at_start": os.getloadavg(), "us_per_lane": {}}
-vals = np.linspace(16, 18, W)
-law = get_contact_law(None)
-pb = lanes_params(p, "omega_pi", vals)
-y0 = jnp.tile(jnp.asarray(jc.initial_state(p)), (W, 1))
-y0 = y0.at[:, 3:6].add(0.3)  # spin a bit
+PARTS = ("rhs", "monitor", "tsit5 step (no monitor)", "monitored step", "_lane_step (ctrl etc)")
 
 
-def timeit(name, f, x):
-    jax.block_until_ready(f(x))
-    dts = []
-    for _ in range(5):
+def _best_us_per_lane(f, x, n_lanes: int, reps: int) -> float:
+    jax.block_until_ready(f(x))  # compile
+    best = np.inf
+    for _ in range(5):  # best of 5: the least disturbed by other processes
         t = time.perf_counter()
         jax.block_until_ready(f(x))
-        dts.append(time.perf_counter() - t)
-    dt = min(dts)
-    RES["us_per_lane"][name] = dt / (reps * W) * 1e6
-    print(f"{name:28s} {dt / (reps * W) * 1e6:7.3f} us/lane", flush=True)
+        best = min(best, time.perf_counter() - t)
+    return best / (reps * n_lanes) * 1e6
 
 
-def loop(fn):
-    def body(i, y):
-        out = jax.vmap(lambda pp, yy: fn(0.1 * i, yy, pp))(pb, y)
-        return y + 1e-30 * jnp.sum(jnp.atleast_2d(out.T).T, axis=-1, keepdims=True)
+def step_parts(p, vals, y0, *, reps: int = 2000, n_samples: int = 100, parts=PARTS) -> dict[str, float]:
+    """µs per lane of each part in ``parts`` (see `PARTS`), lanes = (omega_pi values, y0 (L, 13))."""
+    law = get_contact_law(None)
+    pb = lanes_params(p, "omega_pi", vals)
+    L = len(vals)
+    out: dict[str, float] = {}
 
-    return jax.jit(lambda y: jax.lax.fori_loop(0, reps, body, y))
+    def loop(fn):
+        def body(i, y):
+            o = jax.vmap(lambda pp, yy: fn(0.1 * i, yy, pp))(pb, y)
+            # every output component feeds the carry: otherwise XLA drops the unused parts of
+            # the right-hand side and the timing is too small (an earlier version did that)
+            return y + 1e-30 * jnp.sum(jnp.atleast_2d(o.T).T, axis=-1, keepdims=True)
 
+        return jax.jit(lambda y: jax.lax.fori_loop(0, reps, body, y))
 
-timeit("rhs", loop(lambda t, y, pp: vector_field(t, y, pp, law)), y0)
-timeit("monitor", loop(lambda t, y, pp: _invalid_kind(t, y, pp, law)[1]), y0)
-cfg = SweepConfig(transient_periods=0, sample_periods=NS, stop_on_invalid=True)
-_, solver, term = _pool_parts(cfg)
-tols = jnp.asarray([1e-8, 1e-10])
-T = 2 * jnp.pi / pb.omega_pi
-ts = T[:, None] * jnp.arange(float(NS))[None]
-init = jax.jit(jax.vmap(lambda pp, y, t: _lane_init(cfg, pp, y, t, tols)))
-st0 = init(pb, y0, ts)
-inner = solver.solver
+    evals = {
+        "rhs": lambda t, y, pp: vector_field(t, y, pp, law),
+        "monitor": lambda t, y, pp: _invalid_kind(t, y, pp, law)[1],
+    }
+    for name in parts:
+        if name in evals:
+            out[name] = _best_us_per_lane(loop(evals[name]), y0, L, reps)
+    if not any(name in parts for name in PARTS[2:]):
+        return out
 
+    cfg = SweepConfig(transient_periods=0, sample_periods=n_samples, stop_on_invalid=True)
+    _, solver, term = _pool_parts(cfg)
+    tols = jnp.asarray([1e-8, 1e-10])
+    ts = (2 * jnp.pi / pb.omega_pi)[:, None] * jnp.arange(float(n_samples))[None]
+    st0 = jax.jit(jax.vmap(lambda pp, y, t: _lane_init(cfg, pp, y, t, tols)))(pb, y0, ts)
 
-def bare(st):
-    def body(i, s):
-        y1, ye, _, ss, _ = jax.vmap(
-            lambda s: inner.step(term, s["tprev"], s["tnext"], s["y"], s["p"], s["sstate"][0], False)
+    def bare(s):  # the wrapped diffrax Tsit5 step alone
+        y1, _, _, ss, _ = jax.vmap(
+            lambda s: solver.solver.step(term, s["tprev"], s["tnext"], s["y"], s["p"], s["sstate"][0], False)
         )(s)
         return dict(s, y=y1, sstate=(ss, s["sstate"][1]))
 
-    return jax.lax.fori_loop(0, reps, body, st)
-
-
-timeit("tsit5 step (no monitor)", jax.jit(bare), st0)
-
-
-def mon(st):
-    def body(i, s):
-        y1, ye, _, ss, _ = jax.vmap(
-            lambda s: solver.step(term, s["tprev"], s["tnext"], s["y"], s["p"], s["sstate"], False)
-        )(s)
+    def monitored(s):
+        y1, _, _, ss, _ = jax.vmap(lambda s: solver.step(term, s["tprev"], s["tnext"], s["y"], s["p"], s["sstate"], False))(s)  # fmt: skip
         return dict(s, y=y1, sstate=ss)
 
-    return jax.lax.fori_loop(0, reps, body, st)
+    def full(s):
+        return jax.vmap(lambda s: _lane_step(cfg, s))(s)[0]
+
+    for name, step in zip(PARTS[2:], (bare, monitored, full)):
+        if name in parts:
+            f = jax.jit(lambda st, step=step: jax.lax.fori_loop(0, reps, lambda i, s: step(s), st))
+            out[name] = _best_us_per_lane(f, st0, L, reps)
+    return out
 
 
-timeit("monitored step", jax.jit(mon), st0)
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--width", type=int, default=32, help="lanes (omega_pi 16..18, spinning a little)")
+    ap.add_argument("--samples", type=int, default=100, help="section times the clip controller steps onto")
+    ap.add_argument("--out", type=Path, default=None, help="folder for step_parts.json (optional)")
+    a = ap.parse_args()
+    p = jc.CeltParams.paper()
+    y0 = jnp.tile(jnp.asarray(jc.initial_state(p)), (a.width, 1)).at[:, 3:6].add(0.3)
+    res = {"width": a.width, "load_average_at_start": os.getloadavg()}
+    res["us_per_lane"] = step_parts(p, np.linspace(16, 18, a.width), y0, n_samples=a.samples)
+    for k, v in res["us_per_lane"].items():
+        print(f"{k:28s} {v:7.3f} us/lane", flush=True)
+    if a.out is not None:
+        from jaxcelt.versions import versions
+
+        res["versions"] = versions()
+        a.out.mkdir(parents=True, exist_ok=True)
+        (a.out / "step_parts.json").write_text(json.dumps(res, indent=1))
 
 
-def full(st):
-    def body(i, s):
-        s2, hit = jax.vmap(lambda s: _lane_step(cfg, s))(s)
-        return s2
-
-    return jax.lax.fori_loop(0, reps, body, st)
-
-
-timeit("_lane_step (ctrl etc)", jax.jit(full), st0)
-if OUT is not None:
-    from jaxcelt.versions import versions
-
-    RES["versions"] = versions()
-    OUT.mkdir(parents=True, exist_ok=True)
-    (OUT / "step_parts.json").write_text(json.dumps(RES, indent=1))
+if __name__ == "__main__":
+    main()

@@ -136,43 +136,16 @@ def time_jaxcelt(p, vals, transient, a, scheduler, stop, devices):
 def eval_costs(p, vals, width, reps=2000):
     """Per-lane cost of one vector-field evaluation and one validity-monitor evaluation
     (normal force), vmapped over `width` lanes inside one jitted loop (no dispatch)."""
-    import jax.numpy as jnp
+    from bench_step_parts import step_parts
 
-    from jaxcelt.contact import get_contact_law
-    from jaxcelt.model import vector_field
-    from jaxcelt.solve import _invalid_kind
-    from jaxcelt.sweep import lanes_params
-
-    law = get_contact_law(None)
-    pb = lanes_params(p, "omega_pi", vals[:width])
-    y0 = jnp.tile(jnp.asarray(jc.initial_state(p)), (pb.omega_pi.shape[0], 1))
-
-    def loop(fn):
-        def body(i, y):
-            out = jax.vmap(lambda pp, yy: fn(0.1 * i, yy, pp))(pb, y)
-            # every output component feeds the carry: otherwise XLA drops the unused parts of
-            # the right-hand side and the timing is too small (an earlier version did that)
-            return y + 1e-30 * jnp.sum(jnp.atleast_2d(out.T).T, axis=-1, keepdims=True)
-
-        return jax.jit(lambda y: jax.lax.fori_loop(0, reps, body, y))
-
-    res = {}
-    for name, fn in (
-        ("rhs", lambda t, y, pp: vector_field(t, y, pp, law)),
-        ("monitor", lambda t, y, pp: _invalid_kind(t, y, pp, law)[1]),
-    ):
-        f = loop(fn)
-        jax.block_until_ready(f(y0))
-        best = np.inf
-        for _ in range(5):  # best of 5: the least disturbed by other processes
-            t = time.perf_counter()
-            jax.block_until_ready(f(y0))
-            best = min(best, time.perf_counter() - t)
-        res[f"{name}_us_per_lane"] = best / (reps * pb.omega_pi.shape[0]) * 1e6
+    v = vals[:width]
+    y0 = np.tile(np.asarray(jc.initial_state(p)), (len(v), 1))
+    c = step_parts(p, v, y0, reps=reps, parts=("rhs", "monitor"))
+    res = {"rhs_us_per_lane": c["rhs"], "monitor_us_per_lane": c["monitor"]}
     res["monitor_share_of_step"] = res["monitor_us_per_lane"] / (
         6 * res["rhs_us_per_lane"] + res["monitor_us_per_lane"]
     )
-    res["width"] = int(pb.omega_pi.shape[0])
+    res["width"] = len(v)
     return res
 
 

@@ -528,11 +528,6 @@ def part_e(part, args):
             run(case, w2, y0, stop=True)
 
 
-def merged_a_cells(out):
-    """Cells of (a) with the re-runs merged in (`jaxcelt.benchmarking.stability_results`)."""
-    return bm.stability_results(out).get("a", [])
-
-
 def plot_all(out, slow):
     from jaxcelt.plotting.stability import (
         plot_dt_scan,
@@ -541,7 +536,7 @@ def plot_all(out, slow):
         plot_verdict_grid,
     )
 
-    cells = merged_a_cells(out)
+    cells = bm.stability_results(out).get("a", [])
     if cells:
         title = "(a) friction-smoothing stiffness: stick-slip scene (omega_pi 17, q_pi 0.01 m), 1 period"
         plot_verdict_grid(cells, title, slow=slow).savefig(out / "stability_eps.png", dpi=110)
