@@ -20,6 +20,7 @@ from typing import NamedTuple
 
 import jax.numpy as jnp
 
+from ._math import sincos
 from ._types import Scalar, ScalarLike, State, Vec3
 from .contact import AbstractContactLaw, ContactKinematics, ContactLoads, get_contact_law
 from .params import CeltParams
@@ -94,7 +95,7 @@ def horizontal_frame(n: Vec3, psi: ScalarLike) -> Frame:
     e2 = jnp.array([0.0, 1.0, 0.0], dtype=n.dtype)
     u = (e2 - n[1] * n) / jnp.sqrt(1.0 - n[1] ** 2)
     w = jnp.cross(u, n)
-    c, s = jnp.cos(psi), jnp.sin(psi)
+    s, c = sincos(psi)
     return Frame(E1=c * w - s * u, E2=s * w + c * u)
 
 
@@ -110,7 +111,7 @@ def patch_frame(n: Vec3) -> tuple[Vec3, Vec3]:
 
 def base_velocity(t: ScalarLike, frame: Frame, p: CeltParams) -> Vec3:
     """v_pi = s_pi q_pi omega_pi sin(omega_pi t) E1 in body components [m/s] (eq. 17, A12)."""
-    return p.v_pi_sign * p.q_pi * p.omega_pi * jnp.sin(p.omega_pi * t) * frame.E1
+    return p.v_pi_sign * p.q_pi * p.omega_pi * sincos(p.omega_pi * t)[0] * frame.E1
 
 
 class Kinematics(NamedTuple):
