@@ -37,6 +37,7 @@ __all__ = [
     "normal_force",
     "normal_force_parts",
     "vector_field",
+    "vector_field_and_normal",
     "split_state",
     "STATE_NAMES",
 ]
@@ -211,6 +212,17 @@ def vector_field(
     B w_dot + w x (B w) = rho x N (n + t) + N (m_s + m_r)
     n_dot = -w x n;  r_C_dot = R v (global);  psi_dot = (w1 n1 + w3 n3)/(1 - n2^2)
     """
+    return vector_field_and_normal(t, y, params, contact_law)[0]
+
+
+def vector_field_and_normal(
+    t: ScalarLike, y: State, params: CeltParams, contact_law: AbstractContactLaw | str | None = None
+) -> tuple[State, tuple[Scalar, Scalar]]:
+    """`vector_field` and, from the same evaluation, (N [N], denominator of N [1/kg]).
+
+    What the validity monitor needs, at no extra cost where a solver evaluates the field at a
+    step's end anyway (FSAL Runge-Kutta methods; the sweep's lane pool).
+    """
     p = params
     law = get_contact_law(contact_law)
     kin = kinematics(t, y, p)
@@ -224,4 +236,4 @@ def vector_field(
     w_dot = _solve_B(p, torque - jnp.cross(w, p.B @ w))
     rC_dot = kin.frame.to_global(v, n)
     psi_dot = (w[0] * n[0] + w[2] * n[2]) / (1.0 - n[1] ** 2)
-    return jnp.concatenate([v_dot, w_dot, kin.geom.n_dot, rC_dot, psi_dot[None]])
+    return jnp.concatenate([v_dot, w_dot, kin.geom.n_dot, rC_dot, psi_dot[None]]), (N, den)

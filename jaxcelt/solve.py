@@ -60,8 +60,12 @@ def _invalid_kind(t, y, params, law) -> tuple[Array, Scalar]:
     kin = kinematics(t, y, params)
     num, den = normal_force_parts(kin, contact_loads(kin, params, law), params)
     N = num / den
-    kind = jnp.where(den <= 0, 3, jnp.where(y[8] <= 0, 2, jnp.where(N <= 0, 1, 0)))
-    return kind, N
+    return invalid_kind(N, den, y[8]), N
+
+
+def invalid_kind(N, den, n3) -> Array:
+    """`INVALID_KINDS` code from the normal force N, its denominator and n3 (0: valid)."""
+    return jnp.where(den <= 0, 3, jnp.where(n3 <= 0, 2, jnp.where(N <= 0, 1, 0)))
 
 
 class MonitoredSolver(diffrax.AbstractWrappedSolver):

@@ -80,8 +80,9 @@ from ._types import Array
 from .contact import AbstractContactLaw, get_contact_law
 from .diagnostics import centre_position
 from .lyapunov import celt_lyapunov
+from .model import vector_field_and_normal
 from .params import PARAM_NAMES, CeltParams
-from .solve import DEFAULT_SOLVER, MonitoredSolver, _Field, _fill_implicit_tols, simulate, status_code
+from .solve import DEFAULT_SOLVER, MonitoredSolver, _Field, _fill_implicit_tols, invalid_kind, simulate, status_code
 from .state import initial_state
 
 __all__ = [
@@ -316,20 +317,44 @@ def _controller(tols: Array, ts: Array):
     return diffrax.ClipStepSizeController(pid, step_ts=ts)
 
 
+def _erk_tableau(cfg: SweepConfig) -> Any:
+    """Butcher tableau of an explicit FSAL Runge-Kutta solver (Tsit5, Dopri5, Dopri8, ...) or None.
+
+    For these the pool runs its own fused step (`_erk_lane_step`); any other solver (implicit,
+    non-FSAL) runs diffrax's own step (`_lane_step`)."""
+    tab = getattr(cfg.solver, "tableau", None)
+    if isinstance(cfg.solver, diffrax.AbstractERK) and tab is not None and tab.fsal and tab.b_error is not None:
+        return tab
+    return None
+
+
 def _lane_init(cfg: SweepConfig, p: CeltParams, y0: Array, ts: Array, tols: Array) -> dict[str, Any]:
     """diffeqsolve's initialisation (controller.init picks the first step, solver.init)."""
-    _, solver, term = _pool_parts(cfg)
+    law, solver, term = _pool_parts(cfg)
     t0 = jnp.asarray(cfg.t0, jnp.float64)
     t1 = ts[-1]
     ctrl = _controller(tols, ts)
     tnext, cstate = ctrl.init(term, t0, t1, y0, None, p, solver.func, solver.error_order(term))
     tnext = jnp.minimum(tnext, t1)
-    sstate = solver.init(term, t0, tnext, y0, p)
+    if _erk_tableau(cfg) is None:
+        sstate = solver.init(term, t0, tnext, y0, p)
+        state = dict(sstate=sstate, cstate=cstate)
+    else:
+        # the fused step's state: the FSAL derivative and the monitor, from one evaluation
+        f0, (N, den) = vector_field_and_normal(t0, y0, p, law)
+        kind = invalid_kind(N, den, y0[8])
+        state = dict(
+            f=f0,
+            first_invalid_t=jnp.where(kind > 0, t0, jnp.inf),
+            first_invalid_kind=kind,
+            min_N=N,
+            min_n3=y0[8],
+        )
     floor = t1
     for _ in range(100):  # diffrax's t1_clip_floor: t1 - 100 ULP
         floor = eqxi.prevbefore(floor)
     k0 = (ts[0] <= t0).astype(jnp.int32)  # a section time at t0 is the initial state itself
-    stop0 = jnp.asarray(cfg.stop_on_invalid) & (sstate[1].first_invalid_kind > 0)
+    stop0 = jnp.asarray(cfg.stop_on_invalid) & (_lane_monitor(state)[1] > 0)
     return dict(
         p=p,
         ts=ts,
@@ -339,13 +364,126 @@ def _lane_init(cfg: SweepConfig, p: CeltParams, y0: Array, ts: Array, tols: Arra
         y=y0,
         tprev=t0,
         tnext=tnext,
-        sstate=sstate,
-        cstate=cstate,
         result=diffrax.RESULTS.where(stop0, diffrax.RESULTS.event_occurred, diffrax.RESULTS.successful),
         num_steps=jnp.zeros((), jnp.int32),
         k=k0,
         done=stop0,
+        **state,
     )
+
+
+def _lane_monitor(st: dict[str, Any]) -> tuple[Array, Array, Array, Array]:
+    """(first_invalid_t, first_invalid_kind, min_N, max_tilt) of a slot, either step kernel."""
+    if "sstate" in st:
+        mon = st["sstate"][1]
+        return mon.first_invalid_t, mon.first_invalid_kind, mon.min_N, mon.max_tilt
+    # max over steps of arccos(n3) = arccos(min n3): arccos is decreasing
+    return st["first_invalid_t"], st["first_invalid_kind"], st["min_N"], jnp.arccos(jnp.clip(st["min_n3"], -1, 1))
+
+
+def _combine(y0: Array, coeffs: Any, ks: list[Array]) -> Array:
+    """y0 + sum_j coeffs[j] ks[j] over the non-zero coefficients (tableau constants)."""
+    out = y0
+    for a, k in zip(np.asarray(coeffs, dtype=float), ks):
+        if a != 0.0:
+            out = out + a * k
+    return out
+
+
+def _kernel_boundary(opaque_true: Array) -> Callable[[Array], Array]:
+    """x -> x, materialised: a conditional on a predicate XLA cannot see (a runtime True).
+
+    XLA's CPU fusion copies cheap producers into every consumer kernel, so without this each
+    of the right-hand side's ~40 kernels recomputes the stage input y0 + sum_j a_ij k_j for
+    the components it reads; a conditional is a kernel boundary, after which they read one
+    buffer instead (measured: a Tsit5 lane-step 3.0 -> 2.1 us on one core, 32 lanes). The
+    other branch is never taken; it returns NaN so that it could not pass unnoticed, and it
+    differs from the first so that XLA does not fold the conditional away.
+    """
+
+    def boundary(x: Array) -> Array:
+        return jax.lax.cond(opaque_true, lambda x: x, lambda x: jnp.full_like(x, jnp.nan), x)
+
+    return boundary
+
+
+def _erk_lane_step(
+    cfg: SweepConfig, tab: Any, st: dict[str, Any], boundary: Callable[[Array], Array] = lambda x: x
+) -> tuple[dict[str, Any], Array]:
+    """`_lane_step` for an explicit FSAL Runge-Kutta tableau, fused into one straight-line step.
+
+    The same algorithm as diffrax's loop body with ``PIDController`` (I-control, diffrax's
+    defaults) inside ``ClipStepSizeController(step_ts=ts)``: stages k_i = dt f(t0 + c_i dt,
+    y0 + sum_j a_ij k_j), y1 = y0 + sum b_i k_i, error sum e_i k_i, the RMS error ratio and
+    factor clip(0.9 err^(-1/(order+1)), [1, 10] if accepted else [0.2, 0.9]), the next step
+    clipped onto the next section time and onto t1. The last stage is f(t1, y1) (FSAL); its
+    normal force and denominator feed the validity monitor, so monitoring costs no extra
+    evaluation (diffrax's `MonitoredSolver` evaluates N once more per step). Without diffrax's
+    generic stage loop, stage buffer and dense-output bookkeeping, XLA fuses the step into
+    fewer kernels (``benchmarks/bench_step_parts.py``). Lanes agree with `simulate` to
+    rounding (the arithmetic order differs), with the same step counts (tests).
+    ``boundary``: applied to every stage input (`_kernel_boundary`; identity by default).
+    """
+    R = diffrax.RESULTS
+    law = get_contact_law(cfg.contact_law)
+    p, ts, t1, y0, t0 = st["p"], st["ts"], st["t1"], st["y"], st["tprev"]
+    dt = st["tnext"] - t0
+    ks = [st["f"] * dt]
+    for c, a in zip(np.asarray(tab.c, dtype=float), tab.a_lower):
+        yi = boundary(_combine(y0, a, ks))
+        fi, aux = vector_field_and_normal(t0 + c * dt, yi, p, law)
+        ks.append(fi * dt)
+    b = np.asarray(tab.b_sol, dtype=float)
+    fsal_is_y1 = b[-1] == 0.0 and np.array_equal(np.asarray(tab.a_lower[-1], dtype=float), b[:-1])
+    y1 = yi if fsal_is_y1 else _combine(y0, b, ks)
+    y_err = _combine(jnp.zeros_like(y0), tab.b_error, ks)
+    y_err = jnp.where(jnp.isnan(y_err), jnp.inf, y_err)
+    # diffrax PIDController.adapt_step_size (pcoeff = dcoeff = 0, icoeff = 1)
+    pid = diffrax.PIDController(rtol=st["tols"][0], atol=st["tols"][1])
+    y1s = jnp.where(jnp.isnan(y1).any(), y0, y1)
+    scaled = pid.norm(y_err / (pid.atol + jnp.maximum(jnp.abs(y0), jnp.abs(y1s)) * pid.rtol))
+    keep = scaled < 1
+    inv = 1 / scaled
+    order = cfg.solver.error_order(_pool_parts(cfg)[2])  # order + 1 for an ODE
+    factor = jnp.clip(
+        pid.safety * inv ** (1.0 / order),
+        jnp.where(keep, 1.0, pid.factormin),
+        jnp.where(keep, pid.factormax, pid.safety),
+    )
+    tprev = jnp.where(keep, st["tnext"], t0)
+    tnext = tprev + dt * factor
+    # section times: the accepted step's end *is* the sample when it lands on ts[k]
+    S = ts.shape[0]
+    hit = keep & (st["k"] < S) & (ts[jnp.minimum(st["k"], S - 1)] <= tprev)
+    k = st["k"] + hit.astype(jnp.int32)
+    tnext = jnp.where(k < S, jnp.minimum(ts[jnp.minimum(k, S - 1)], tnext), tnext)  # diffrax's _clip_t
+    tprev = jnp.minimum(tprev, t1)
+    tnext = jnp.where(tnext > st["floor"], jnp.where(keep, t1, tprev + 0.5 * (t1 - tprev)), tnext)
+    # validity monitor at the accepted step's end (N, den from the FSAL evaluation)
+    N, den = aux
+    kind = invalid_kind(N, den, y1[8])
+    new_invalid = keep & (kind > 0) & (st["first_invalid_kind"] == 0)
+    result = st["result"]
+    if cfg.stop_on_invalid:
+        result = R.where(new_invalid & (result == R.successful), R.event_occurred, result)
+    num_steps = st["num_steps"] + 1
+    done = (result != R.successful) | (tprev >= t1) | (num_steps >= cfg.max_steps)
+    new = dict(
+        st,
+        y=jnp.where(keep, y1, y0),
+        f=jnp.where(keep, fi, st["f"]),
+        tprev=tprev,
+        tnext=tnext,
+        first_invalid_t=jnp.where(new_invalid, tprev, st["first_invalid_t"]),
+        first_invalid_kind=jnp.where(new_invalid, kind, st["first_invalid_kind"]),
+        min_N=jnp.where(keep, jnp.minimum(st["min_N"], N), st["min_N"]),
+        min_n3=jnp.where(keep, jnp.minimum(st["min_n3"], y1[8]), st["min_n3"]),
+        result=result,
+        num_steps=num_steps,
+        k=k,
+        done=done,
+    )
+    return new, hit
 
 
 def _lane_step(cfg: SweepConfig, st: dict[str, Any]) -> tuple[dict[str, Any], Array]:
@@ -401,12 +539,34 @@ def _lane_status(st: dict[str, Any]) -> Array:
 
 
 def _pool(
-    pb: CeltParams, y0b: Array, live: Array, transient: Array, tols: Array, cfg: SweepConfig, width: int
+    pb: CeltParams,
+    y0b: Array,
+    live: Array,
+    transient: Array,
+    tols: Array,
+    cfg: SweepConfig,
+    width: int,
+    vary: tuple[bool, ...] | None = None,
+    opaque_true: Array | bool = True,
 ) -> dict[str, Array]:
     """All lanes of ``pb``/``y0b`` through ``width`` slots (refilled as lanes finish).
 
     ``live`` (L,) bool: False marks padding lanes, which finish at once and cost nothing.
+    ``vary`` (static, one flag per leaf of ``pb``; None = all): the parameters that differ
+    between lanes. Only those ride in the slots; the others enter the step as unbatched
+    constants, so XLA computes what depends on them alone (inertia adjugate, elliptic
+    integrals, b_Ts^m_Ts, ...) once instead of in every slot at every stage.
+    ``opaque_true``: a traced True (a jit argument) for `_kernel_boundary`.
     """
+    leaves, treedef = jax.tree_util.tree_flatten(pb)
+    vary = tuple(vary) if vary is not None else (True,) * len(leaves)
+    const = [x[0] for x in leaves]
+    pv_all = tuple(x for x, v in zip(leaves, vary) if v)
+
+    def params_of(pv):
+        it = iter(pv)
+        return jax.tree_util.tree_unflatten(treedef, [next(it) if v else c for v, c in zip(vary, const)])
+
     L = y0b.shape[0]
     B = min(width, L)
     S = cfg.sample_periods
@@ -414,16 +574,27 @@ def _pool(
     T = 2 * jnp.pi / pb.omega_pi
     ts_all = t0 + T[:, None] * (transient + jnp.arange(S, dtype=jnp.float64))[None, :]
 
-    def _init(p, y, ts, lv):
-        st = _lane_init(cfg, p, y, ts, tols)
-        return dict(st, done=st["done"] | ~lv, at_t0=st["k"] > 0)
+    def _init(pv, y, ts, lv):
+        st = _lane_init(cfg, params_of(pv), y, ts, tols)
+        return dict(st, p=pv, done=st["done"] | ~lv, at_t0=st["k"] > 0)
+
+    tab = _erk_tableau(cfg)
+
+    def _step(st):
+        pv = st["p"]
+        st = dict(st, p=params_of(pv))
+        if tab is None:
+            new, hit = _lane_step(cfg, st)
+        else:
+            new, hit = _erk_lane_step(cfg, tab, st, _kernel_boundary(jnp.asarray(opaque_true)))
+        return dict(new, p=pv), hit
 
     init_v = jax.vmap(_init)
-    step_v = jax.vmap(lambda st: _lane_step(cfg, st))
+    step_v = jax.vmap(_step)
 
     def take(idx):
         j = jnp.minimum(idx, L - 1)
-        return jax.tree_util.tree_map(lambda x: x[j], pb), y0b[j], ts_all[j], live[j]
+        return tuple(x[j] for x in pv_all), y0b[j], ts_all[j], live[j]
 
     out = dict(
         samples=jnp.full((L, S, 13), jnp.inf),
@@ -445,15 +616,15 @@ def _pool(
 
     def finish(out, lane, st, fin):
         w = jnp.where(fin & (lane < L), lane, L)
-        mon = st["sstate"][1]
+        first_t, first_kind, min_N, max_tilt = _lane_monitor(st)
         for key, val in (
             ("y_final", st["y"]),
             ("status", _lane_status(st)),
             ("num_steps", st["num_steps"]),
-            ("first_invalid_t", mon.first_invalid_t),
-            ("first_invalid_kind", mon.first_invalid_kind.astype(jnp.int32)),
-            ("min_N", mon.min_N),
-            ("max_tilt", mon.max_tilt),
+            ("first_invalid_t", first_t),
+            ("first_invalid_kind", first_kind.astype(jnp.int32)),
+            ("min_N", min_N),
+            ("max_tilt", max_tilt),
         ):
             out[key] = out[key].at[w].set(val, mode="drop")
         return out
@@ -526,10 +697,19 @@ def _sharded(run: Callable, mesh: Any, n_in: int) -> Callable:
 
 @eqx.filter_jit
 def _pool_chunk(
-    pb: CeltParams, y0b: Array, live: Array, transient: Array, tols: Array, cfg: SweepConfig, width: int, mesh: Any
+    pb: CeltParams,
+    y0b: Array,
+    live: Array,
+    transient: Array,
+    tols: Array,
+    cfg: SweepConfig,
+    width: int,
+    mesh: Any,
+    vary: tuple[bool, ...],
+    opaque_true: Array,
 ) -> dict[str, Array]:
     def run(pb, y0b, live):
-        out = _pool(pb, y0b, live, transient, tols, cfg, width)
+        out = _pool(pb, y0b, live, transient, tols, cfg, width, vary, opaque_true)
         out.update(jax.vmap(_extras)(out["samples"], pb))
         return out
 
@@ -569,6 +749,7 @@ def run_lanes(
     scheduler: str = "pool",
     width: int | None = None,
     compile_only: bool = False,
+    varying: Sequence[str] = (),
 ) -> dict[str, np.ndarray]:
     """Run one chunk of lanes (batched params and y0 with a leading lane axis) and return numpy arrays.
 
@@ -586,6 +767,10 @@ def run_lanes(
     of the device count. Padding lanes are dropped; in the pool they finish at once.
     ``compile_only=True`` (pool): every lane marked as padding -- compiles the kernel for
     these shapes and returns at once (used to time compilation apart from running).
+    ``varying``: names of parameters to treat as differing between lanes even where this
+    chunk's lanes happen to share a value (parameters that do differ are always detected),
+    so that all chunks of a sweep compile to one kernel; the others are constants of the
+    pool's step (see `_pool`).
     """
     if scheduler not in SCHEDULERS:
         raise ValueError(f"scheduler must be one of {SCHEDULERS}, got {scheduler!r}")
@@ -607,6 +792,11 @@ def run_lanes(
     perm = np.arange(Lp).reshape(-1, ndev).T.reshape(-1)
     live = (np.arange(Lp)[perm] < L) & (not compile_only)
     nocfg = dataclasses.replace(static_cfg, lyapunov_periods=0)
+    unknown = set(varying) - set(PARAM_NAMES)
+    if unknown:
+        raise ValueError(f"varying: unknown parameter name(s) {sorted(unknown)}")
+    path_leaves = jax.tree_util.tree_flatten_with_path(pb_np)[0]
+    vary = tuple(bool(path[-1].name in varying or np.any(x != x[:1])) for path, x in path_leaves)
     out = _pool_chunk(
         jax.tree_util.tree_map(lambda x: x[perm], pb_np),
         y0_np[perm],
@@ -616,6 +806,8 @@ def run_lanes(
         nocfg,
         min(W, Lp // ndev),
         mesh,
+        vary,
+        jnp.asarray(True),
     )
     out = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(out))
     inv = np.empty_like(perm)
@@ -776,7 +968,9 @@ def sweep(
             continue
         pb = jax.tree_util.tree_map(lambda x, idx=idx: np.asarray(x)[idx], pb_all)
         t_start = time.perf_counter()
-        res = run_lanes(pb, lane_y0[idx], cfg, devices=devices, pad_to=cs, scheduler=scheduler, width=width)
+        res = run_lanes(
+            pb, lane_y0[idx], cfg, devices=devices, pad_to=cs, scheduler=scheduler, width=width, varying=(name,)
+        )
         res["_seconds"] = np.full(len(idx), (time.perf_counter() - t_start) / len(idx))
         results[ci] = res
         if writer is not None:
