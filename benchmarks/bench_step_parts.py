@@ -1,8 +1,10 @@
-"""Where a sweep step's time goes: per-lane cost of one vector-field evaluation, the validity
-monitor, a bare diffrax Tsit5 step (6 RHS + RK bookkeeping), the monitored step, and the lane
-pool's full step (controller, clipping, selects), each vmapped over the lanes inside one
-jitted loop (no dispatch), best of 5. One JAX device. `step_parts` is also what
-``bench_sweep.py`` uses for its per-evaluation costs.
+"""Where a sweep step's time goes: per-lane cost of one vector-field evaluation, diffrax's
+Tsit5 step with `MonitoredSolver` (what `simulate` runs: 6 RHS + RK bookkeeping + the monitor's
+extra normal-force evaluation), the pool's fused step (`jaxcelt.sweep._erk_lane_step`: 6 RHS,
+monitor from the FSAL evaluation, PID + section clipping) with and without its stage-input
+kernel boundaries, and the full pool iteration is `bench_pool_width.py`'s business. Each part
+is vmapped over the lanes inside one jitted loop (no dispatch), best of 5, one JAX device.
+`step_parts` is also what ``bench_sweep.py`` uses for its per-evaluation costs.
 
     .venv/bin/python benchmarks/bench_step_parts.py [--width 32] [--samples 100] [--out docs/bifurcation]
 """
@@ -23,9 +25,23 @@ import jaxcelt as jc
 from jaxcelt.contact import get_contact_law
 from jaxcelt.model import vector_field
 from jaxcelt.solve import _invalid_kind
-from jaxcelt.sweep import SweepConfig, _lane_init, _lane_step, _pool_parts, lanes_params
+from jaxcelt.sweep import (
+    SweepConfig,
+    _erk_lane_step,
+    _erk_tableau,
+    _kernel_boundary,
+    _lane_init,
+    _pool_parts,
+    lanes_params,
+)
 
-PARTS = ("rhs", "monitor", "tsit5 step (no monitor)", "monitored step", "_lane_step (ctrl etc)")
+PARTS = (
+    "rhs",
+    "monitor",
+    "diffrax tsit5 step + monitor",
+    "fused step, no stage boundaries",
+    "fused step (pool)",
+)
 
 
 def _best_us_per_lane(f, x, n_lanes: int, reps: int) -> float:
@@ -66,27 +82,34 @@ def step_parts(p, vals, y0, *, reps: int = 2000, n_samples: int = 100, parts=PAR
 
     cfg = SweepConfig(transient_periods=0, sample_periods=n_samples, stop_on_invalid=True)
     _, solver, term = _pool_parts(cfg)
+    tab = _erk_tableau(cfg)
     tols = jnp.asarray([1e-8, 1e-10])
     ts = (2 * jnp.pi / pb.omega_pi)[:, None] * jnp.arange(float(n_samples))[None]
     st0 = jax.jit(jax.vmap(lambda pp, y, t: _lane_init(cfg, pp, y, t, tols)))(pb, y0, ts)
+    # diffrax's path needs its own solver state (the fused step's lane state has none)
+    st_d = dict(st0, sstate=jax.jit(jax.vmap(lambda s: solver.init(term, s["tprev"], s["tnext"], s["y"], s["p"])))(st0))
 
-    def bare(s):  # the wrapped diffrax Tsit5 step alone
-        y1, _, _, ss, _ = jax.vmap(
-            lambda s: solver.solver.step(term, s["tprev"], s["tnext"], s["y"], s["p"], s["sstate"][0], False)
-        )(s)
-        return dict(s, y=y1, sstate=(ss, s["sstate"][1]))
-
-    def monitored(s):
+    def diffrax_step(s):  # the wrapped diffrax Tsit5 step + validity monitor, as in `simulate`
         y1, _, _, ss, _ = jax.vmap(lambda s: solver.step(term, s["tprev"], s["tnext"], s["y"], s["p"], s["sstate"], False))(s)  # fmt: skip
         return dict(s, y=y1, sstate=ss)
 
-    def full(s):
-        return jax.vmap(lambda s: _lane_step(cfg, s))(s)[0]
+    def fused(boundaries):
+        def step(s, flag):
+            b = _kernel_boundary(flag) if boundaries else (lambda x: x)
+            return jax.vmap(lambda s: _erk_lane_step(cfg, tab, s, b))(s)[0]
 
-    for name, step in zip(PARTS[2:], (bare, monitored, full)):
+        return step
+
+    runs = {
+        "diffrax tsit5 step + monitor": (lambda s, flag: diffrax_step(s), st_d),
+        "fused step, no stage boundaries": (fused(False), st0),
+        "fused step (pool)": (fused(True), st0),
+    }
+    for name, (step, st) in runs.items():
         if name in parts:
-            f = jax.jit(lambda st, step=step: jax.lax.fori_loop(0, reps, lambda i, s: step(s), st))
-            out[name] = _best_us_per_lane(f, st0, L, reps)
+            # the boundary's predicate is a jit argument, opaque to XLA, as in the pool
+            f = jax.jit(lambda st, flag, step=step: jax.lax.fori_loop(0, reps, lambda i, s: step(s, flag), st))
+            out[name] = _best_us_per_lane(lambda st, f=f: f(st, jnp.asarray(True)), st, L, reps)
     return out
 
 
@@ -101,7 +124,7 @@ def main() -> None:
     res = {"width": a.width, "load_average_at_start": os.getloadavg()}
     res["us_per_lane"] = step_parts(p, np.linspace(16, 18, a.width), y0, n_samples=a.samples)
     for k, v in res["us_per_lane"].items():
-        print(f"{k:28s} {v:7.3f} us/lane", flush=True)
+        print(f"{k:34s} {v:7.3f} us/lane", flush=True)
     if a.out is not None:
         from jaxcelt.versions import versions
 

@@ -1,6 +1,7 @@
 """Benchmark: one stroboscopic frequency sweep, four ways, side by side.
 
-1. jaxcelt vmapped (`jaxcelt.bifurcation`, chunks of lanes, Tsit5 + exact section times)
+1. jaxcelt vmapped (`jaxcelt.bifurcation`: the lane pool, exact section times), with Tsit5 (the
+   default) and with Dopri8 (the same 8th-order Dormand-Prince family as scipy's DOP853)
 2. jaxcelt one lane at a time (`jaxcelt.simulate` in a Python loop; subset, extrapolated)
 3. scipy ``solve_ivp(DOP853)`` with the numba RHS, lane by lane (subset, extrapolated)
 4. numba hand-written adaptive Dormand-Prince 5(4) ensemble (prange over lanes; all lanes)
@@ -73,20 +74,24 @@ def scipy_lane(y0, ts, P, B, Bi, rtol, atol, stop_invalid=False):
     return ys, sol.nfev, sol.status
 
 
-def time_jaxcelt(p, vals, transient, a, scheduler, stop, devices):
+def time_jaxcelt(p, vals, transient, a, scheduler, stop, devices, solver=None):
     """Compile apart, then the sweep; step-slot accounting from the pool's loop counters."""
+    import diffrax
+
     from jaxcelt.sweep import SweepConfig, lanes_params, run_lanes
 
+    solver = solver if solver is not None else diffrax.Tsit5()
     kw = dict(
         sample_periods=a.sample, rtol=a.rtol, atol=a.atol, chunk_size=a.chunk_size, sort_by_cost=True,
-        scheduler=scheduler, width=a.width, stop_on_invalid=stop, devices=devices,
+        scheduler=scheduler, width=a.width, stop_on_invalid=stop, devices=devices, solver=solver,
     )  # fmt: skip
     cs = min(a.chunk_size, len(vals))
     t = time.perf_counter()
     if scheduler == "pool":
         cfg = SweepConfig(
-            transient_periods=transient, sample_periods=a.sample, rtol=a.rtol, atol=a.atol, stop_on_invalid=stop
-        )
+            transient_periods=transient, sample_periods=a.sample, rtol=a.rtol, atol=a.atol, stop_on_invalid=stop,
+            solver=solver,
+        )  # fmt: skip
         y0 = np.tile(np.asarray(jc.initial_state(p)), (cs, 1))
         run_lanes(
             lanes_params(p, "omega_pi", vals[:cs]), y0, cfg, pad_to=cs, width=a.width, compile_only=True,
@@ -110,8 +115,12 @@ def time_jaxcelt(p, vals, transient, a, scheduler, stop, devices):
         slots = int(sum(int(c["num_steps"].max()) * len(c["num_steps"]) for c in chunks))
     per_period = r.num_steps / (transient + a.sample)
     inval = ~r.valid
-    # Tsit5: 6 RHS per step (FSAL) + 1 normal-force evaluation of the validity monitor
+    # RHS evaluations per step: the tableau's stages less the first (FSAL): Tsit5 6, Dopri8 13.
+    # The pool's validity monitor reads N from the last (FSAL) evaluation: no extra evaluation.
+    ne = len(solver.tableau.c)
     return dict(
+        solver=type(solver).__name__,
+        rhs_per_step=ne,
         devices=ndev,
         seconds=t_run,
         compile_seconds=t_compile,
@@ -119,11 +128,11 @@ def time_jaxcelt(p, vals, transient, a, scheduler, stop, devices):
         total_steps=useful,
         step_slots=slots,
         wasted_slot_fraction=1 - useful / slots,
-        us_per_rhs_slot=t_run / (slots * 7) * 1e6,
-        us_per_useful_rhs=t_run / (useful * 7) * 1e6,
-        # core-seconds per RHS evaluation (6 per Tsit5 step; the monitor counted as overhead):
-        # comparable with numba_dp5_ensemble's us_per_rhs_cpu (threads x wall / evaluations)
-        core_us_per_rhs=t_run * ndev / (useful * 6) * 1e6,
+        us_per_rhs_slot=t_run / (slots * ne) * 1e6,
+        us_per_useful_rhs=t_run / (useful * ne) * 1e6,
+        # core-seconds per RHS evaluation, everything else (bookkeeping, wasted slots) counted
+        # as overhead: comparable with numba_dp5_ensemble's us_per_rhs_cpu (threads x wall / evaluations)
+        core_us_per_rhs=t_run * ndev / (useful * ne) * 1e6,
         steps_per_period_percentiles_0_25_50_75_90_100=[
             float(x) for x in np.percentile(per_period, [0, 25, 50, 75, 90, 100])
         ],
@@ -134,17 +143,15 @@ def time_jaxcelt(p, vals, transient, a, scheduler, stop, devices):
 
 
 def eval_costs(p, vals, width, reps=2000):
-    """Per-lane cost of one vector-field evaluation and one validity-monitor evaluation
-    (normal force), vmapped over `width` lanes inside one jitted loop (no dispatch)."""
+    """Per-lane cost of one vector-field evaluation and of one fused Tsit5 step of the pool
+    (6 RHS + bookkeeping), vmapped over `width` lanes inside one jitted loop (no dispatch)."""
     from bench_step_parts import step_parts
 
     v = vals[:width]
     y0 = np.tile(np.asarray(jc.initial_state(p)), (len(v), 1))
-    c = step_parts(p, v, y0, reps=reps, parts=("rhs", "monitor"))
-    res = {"rhs_us_per_lane": c["rhs"], "monitor_us_per_lane": c["monitor"]}
-    res["monitor_share_of_step"] = res["monitor_us_per_lane"] / (
-        6 * res["rhs_us_per_lane"] + res["monitor_us_per_lane"]
-    )
+    c = step_parts(p, v, y0, reps=reps, parts=("rhs", "fused step (pool)"))
+    res = {"rhs_us_per_lane": c["rhs"], "fused_step_us_per_lane": c["fused step (pool)"]}
+    res["rhs_share_of_step"] = 6 * res["rhs_us_per_lane"] / res["fused_step_us_per_lane"]
     res["width"] = len(v)
     return res
 
@@ -232,13 +239,19 @@ def main():
 
     # 1. jaxcelt vmapped (lane pool): stop-on-invalid (the CLI default) on all devices and on one;
     #    integrating invalid lanes on (the same work as the loops without events)
-    runs = [("pool_stop_on_invalid", "pool", True, devs), ("pool", "pool", False, devs)]
+    import diffrax
+
+    runs = [
+        ("pool_stop_on_invalid", "pool", True, devs, None),
+        ("pool_stop_on_invalid_dopri8", "pool", True, devs, diffrax.Dopri8()),
+        ("pool", "pool", False, devs, None),
+    ]
     if len(devs) > 1:
-        runs.insert(1, ("pool_stop_on_invalid_1dev", "pool", True, devs[:1]))
+        runs.insert(1, ("pool_stop_on_invalid_1dev", "pool", True, devs[:1], None))
     if a.with_chunks:
-        runs.append(("chunks", "chunks", False, devs))
-    for key, sched, stop, dv in runs:
-        res[f"jaxcelt_{key}"] = time_jaxcelt(p, vals, transient, a, sched, stop, dv)
+        runs.append(("chunks", "chunks", False, devs, None))
+    for key, sched, stop, dv, solver in runs:
+        res[f"jaxcelt_{key}"] = time_jaxcelt(p, vals, transient, a, sched, stop, dv, solver)
         print(key, res[f"jaxcelt_{key}"], flush=True)
     res["per_lane_eval_cost"] = eval_costs(p, vals, a.width)
     print("per-lane evaluation cost (vmapped, one device)", res["per_lane_eval_cost"], flush=True)
@@ -277,15 +290,20 @@ def main():
     TSa = TSa[:, 1:]
     ref = np.stack([scipy_lane(Y0a[i], TSa[i], PPa[i], B, Bi, 1e-12, 1e-14)[0] for i in range(len(sub))])
     ra = bifurcation(p, vals[sub], transient_periods=1, sample_periods=5, rtol=a.rtol, atol=a.atol)
+    ra8 = bifurcation(
+        p, vals[sub], transient_periods=1, sample_periods=5, rtol=a.rtol, atol=a.atol, solver=diffrax.Dopri8()
+    )
     ys_a, *_ = nm.dopri_ensemble(Y0a, TSa, PPa, B, Bi, a.rtol, a.atol, 10**7)
     sp_a = np.stack([scipy_lane(Y0a[i], TSa[i], PPa[i], B, Bi, a.rtol, a.atol)[0] for i in range(len(sub))])
     res["accuracy_max_abs_err_5_periods_vs_dop853_1e-12"] = dict(
         jaxcelt=float(np.max(np.abs(ra.samples - ref))),
+        jaxcelt_dopri8=float(np.max(np.abs(ra8.samples - ref))),
         numba_dp5=float(np.max(np.abs(ys_a - ref))),
         scipy_dop853=float(np.max(np.abs(sp_a - ref))),
     )
     print("accuracy", res["accuracy_max_abs_err_5_periods_vs_dop853_1e-12"], flush=True)
     js, jv = res["jaxcelt_pool_stop_on_invalid"], res["jaxcelt_pool"]
+    j8 = res["jaxcelt_pool_stop_on_invalid_dopri8"]
     ns, nv = res["numba_dp5_ensemble_stop_on_invalid"], res["numba_dp5_ensemble"]
     ss, sv = res["scipy_dop853_numba_rhs_stop_on_invalid"], res["scipy_dop853_numba_rhs"]
     res["summary"] = dict(
@@ -297,6 +315,9 @@ def main():
         target_120s_met=bool(js["seconds"] + js["compile_seconds"] <= 120) if (a.n_freq, a.periods) == (400, 300) else None,
         # same work: both stop invalid lanes / both integrate every lane to the end
         speedup_vs_scipy_loop_same_work_stop=ss["extrapolated_seconds"] / js["seconds"],
+        jaxcelt_dopri8_stop_on_invalid_s=j8["seconds"],
+        speedup_vs_scipy_loop_same_work_stop_dopri8=ss["extrapolated_seconds"] / j8["seconds"],
+        per_rhs_ratio_jaxcelt_dopri8_vs_numba=j8["core_us_per_rhs"] / ns["us_per_rhs_cpu"],
         speedup_vs_scipy_loop_same_work_integrate_on=sv["extrapolated_seconds"] / jv["seconds"],
         speedup_vs_scipy_loop_integrating_on=sv["extrapolated_seconds"] / js["seconds"],
         speedup_vs_jaxcelt_lane_by_lane=res["jaxcelt_lane_by_lane"]["extrapolated_seconds"] / js["seconds"],
@@ -318,6 +339,7 @@ def main():
 
     rows = [
         (f"jaxcelt pool\n{len(devs)} dev", js["seconds"], jv["seconds"], "tab:blue"),
+        (f"jaxcelt pool\nDopri8, {len(devs)} dev", j8["seconds"], None, "tab:olive"),
     ]
     if "jaxcelt_pool_stop_on_invalid_1dev" in res:
         rows.append(("jaxcelt pool\n1 dev", res["jaxcelt_pool_stop_on_invalid_1dev"]["seconds"], None, "tab:cyan"))

@@ -937,7 +937,7 @@ def sweep(
     order = np.arange(L)
     if sort_by_cost:
         order = np.argsort(np.asarray(pb_all.omega_pi), kind="stable")  # longest period first
-    cs = L if chunk_size is None else max(1, int(chunk_size))
+    cs = L if chunk_size is None else max(1, min(int(chunk_size), L))  # no padding beyond the lanes
     chunks = [order[i : i + cs] for i in range(0, L, cs)]
 
     writer = None
