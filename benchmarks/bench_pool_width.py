@@ -48,7 +48,7 @@ def main() -> None:
         t = time.perf_counter()
         out = run_lanes(pb, y0, cfg, width=W)
         tr = time.perf_counter() - t
-        slots = int(out["pool_iterations"][0]) * W * ndev
+        slots = int(out["pool_slot_steps"][0]) * ndev  # every device pays its own slots
         steps = int(out["num_steps"].sum())
         row = dict(width_per_device=W, compile_s=tc, run_s=tr, steps=steps, slots=slots,
                    wasted=1 - steps / slots, us_per_slot=tr / slots * 1e6)  # fmt: skip

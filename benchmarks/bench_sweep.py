@@ -109,8 +109,8 @@ def time_jaxcelt(p, vals, transient, a, scheduler, stop, devices, solver=None):
     useful = int(r.num_steps.sum())
     ndev = len(devices)
     if scheduler == "pool":
-        # every device runs its own pool of pool_width slots for pool_iterations iterations
-        slots = ndev * int(sum(int(c["pool_iterations"][0]) * int(c["pool_width"][0]) for c in chunks))
+        # every device runs its own pool; pool_slot_steps counts its slots over all drain widths
+        slots = ndev * int(sum(int(c["pool_slot_steps"][0]) for c in chunks))
     else:
         slots = int(sum(int(c["num_steps"].max()) * len(c["num_steps"]) for c in chunks))
     per_period = r.num_steps / (transient + a.sample)
@@ -193,7 +193,7 @@ def main():
     ap.add_argument("--rtol", type=float, default=1e-8)
     ap.add_argument("--atol", type=float, default=1e-10)
     ap.add_argument("--chunk-size", type=int, default=400, help="lanes per pool launch (resumable unit)")
-    ap.add_argument("--width", type=int, default=32, help="pool slots per device (vmap width)")
+    ap.add_argument("--width", type=int, default=64, help="pool slots per device (vmap width; the library default)")
     ap.add_argument("--host-devices", default="auto", help="CPU JAX devices to shard lanes over ('auto' = CPU cores)")
     ap.add_argument("--with-chunks", action="store_true", help="also time the old chunk scheduler")
     ap.add_argument("--subset", type=int, default=8, help="lanes (evenly spread) for the lane-by-lane methods")

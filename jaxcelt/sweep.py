@@ -11,11 +11,17 @@ Execution model
 ---------------
 * Lanes are processed in chunks of ``chunk_size`` (the unit of resumable writing). The
   default ``scheduler="pool"`` runs a chunk as **one** jitted while loop over ``width``
-  batch slots (`_pool`): each iteration makes one step in every slot (the step is diffrax's
-  own loop body -- `MonitoredSolver` step, PID + ClipStepSizeController, the same first-step
-  choice -- so a lane equals `jaxcelt.simulate` step for step), and a slot whose lane
+  batch slots (`_pool`): each iteration makes one step in every slot, and a slot whose lane
   finished is refilled with the next lane at once. Step slots are therefore only wasted in
-  the final drain, not for every lane until the slowest one is done. Lane order (and hence
+  the final drain, not for every lane until the slowest one is done. The step is the
+  algorithm of diffrax's loop body (PID + ClipStepSizeController, the same first-step
+  choice, the validity monitor): for explicit FSAL Runge-Kutta solvers (Tsit5, the default;
+  Dopri5, Dopri8, ...) written out as one fused step (`_erk_lane_step`: the monitor reads N
+  from the step's last evaluation, stage inputs are materialised once, lane-constant
+  parameters stay out of the slots), otherwise diffrax's own step (`_lane_step`). A Tsit5
+  lane equals `jaxcelt.simulate` to rounding with the same step count (tests); with
+  Dopri8, whose error weights cancel strongly, rounding moves the step-size sequence
+  slightly (a few steps in ~400, samples ~1e-9 apart at rtol 1e-7). Lane order (and hence
   slot assignment) is fixed and the per-lane arithmetic does not depend on the slot, so
   results are deterministic and a lane's result does not depend on its neighbours (a lane
   that hits ``max_steps`` is flagged and the others are bitwise unchanged).
@@ -631,13 +637,9 @@ def _pool(
 
     lane = jnp.arange(B, dtype=jnp.int32)
     slots = init_v(*take(lane))
-    carry0 = (slots, lane, jnp.asarray(B, jnp.int32), out, jnp.zeros((), jnp.int32))
-
-    def cond(c):
-        return jnp.any(c[1] < L)
 
     def body(c):
-        slots, lane, nxt, out, iters = c
+        slots, lane, nxt, out, iters, slot_steps = c
         out = write_initial(out, lane, slots)
         slots = dict(slots, at_t0=jnp.zeros_like(slots["at_t0"]))
         active = (lane < L) & ~slots["done"]
@@ -664,11 +666,33 @@ def _pool(
             )
 
         slots = jax.lax.cond(jnp.any(refill), do_refill, lambda s: s, slots)
-        return slots, lane, nxt, out, iters + 1
+        return slots, lane, nxt, out, iters + 1, slot_steps + lane.shape[0]
 
-    _, _, _, out, iters = jax.lax.while_loop(cond, body, carry0)
+    # The drain: once no more than a quarter of the slots have work left (running lanes plus
+    # lanes not yet started), the running lanes are gathered into a pool a quarter as wide
+    # and go on there (widths B, B/4, B/16, ... down to 8), so that the end of a chunk does
+    # not pay for idle slots at the full width's cost. Per-lane results do not depend on the
+    # width (vectorised widths >= 4 give bitwise equal lanes; tested).
+    widths = [B]
+    while widths[-1] // 4 >= 8:
+        widths.append(widths[-1] // 4)
+    z = jnp.zeros((), jnp.int32)
+    carry = (slots, lane, jnp.asarray(B, jnp.int32), out, z, z)
+    for nxt_w in [*widths[1:], 0]:
+
+        def cond(c, nxt_w=nxt_w):
+            work = jnp.sum(c[1] < L) + jnp.maximum(L - c[2], 0)
+            return jnp.any(c[1] < L) & (work > nxt_w)
+
+        carry = jax.lax.while_loop(cond, body, carry)
+        if nxt_w:
+            slots, lane = carry[0], carry[1]
+            keep = jnp.argsort(lane >= L, stable=True)[:nxt_w]  # the running lanes first
+            carry = (jax.tree_util.tree_map(lambda x, keep=keep: x[keep], slots), lane[keep], *carry[2:])
+    _, _, _, out, iters, slot_steps = carry
     out["t_samples"] = ts_all
-    out["pool_iterations"] = jnp.full((L,), iters)  # loop iterations x slots = step slots paid
+    out["pool_iterations"] = jnp.full((L,), iters)
+    out["pool_slot_steps"] = jnp.full((L,), slot_steps)  # step slots paid, over all widths
     out["pool_width"] = jnp.full((L,), B)
     return out
 
@@ -736,7 +760,8 @@ def _pad(x: np.ndarray, n: int) -> np.ndarray:
 
 
 SCHEDULERS = ("pool", "chunks")
-DEFAULT_WIDTH = 32
+DEFAULT_WIDTH = 64
+"""pool slots per device (``benchmarks/bench_pool_width.py``: 64 was fastest for 400 lanes on 2 cores)"""
 
 
 def run_lanes(

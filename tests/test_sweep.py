@@ -201,3 +201,23 @@ def test_pool_other_solvers_equal_simulate(paper_params, solver):
         else:
             assert int(sol.num_steps) == int(r.num_steps[i])
             assert err <= 1e-10, err
+
+
+def test_pool_drain_compaction_keeps_lanes_bitwise(paper_params):
+    # 40 lanes through 32 slots: once <= 8 lanes are left the pool continues 8 wide
+    # (`_pool`'s drain). Lanes must not depend on the width they ran at: compare with a
+    # pool that is 8 wide from the start (bitwise; vectorised widths give identical lanes).
+    from jaxcelt.sweep import SweepConfig, run_lanes
+
+    vals = np.linspace(12.0, 19.0, 40)
+    y0 = np.tile(np.asarray(jc.initial_state(paper_params)), (len(vals), 1))
+    pb = lanes_params(paper_params, "omega_pi", vals)
+    cfg = SweepConfig(transient_periods=0, sample_periods=2, max_steps=4000)
+    wide = run_lanes(pb, y0, cfg, width=32, devices=jc.sweep.jax.local_devices()[:1])
+    narrow = run_lanes(pb, y0, cfg, width=8, devices=jc.sweep.jax.local_devices()[:1])
+    it, paid = int(wide["pool_iterations"][0]), int(wide["pool_slot_steps"][0])
+    assert paid < 32 * it  # the drain ran narrower
+    assert paid >= int(wide["num_steps"].sum())
+    np.testing.assert_array_equal(wide["num_steps"], narrow["num_steps"])
+    np.testing.assert_array_equal(wide["samples"], narrow["samples"])
+    np.testing.assert_array_equal(wide["status"], narrow["status"])

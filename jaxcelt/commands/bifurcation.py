@@ -44,7 +44,10 @@ def register(sub) -> None:
         help="lanes per jitted pool launch (the unit of resumable writing); split over the devices",
     )
     p.add_argument(
-        "--width", type=int, default=32, help="pool slots per device: lanes stepped side by side (vmap width)"
+        "--width",
+        type=int,
+        default=None,
+        help="pool slots per device: lanes stepped side by side (vmap width; default jaxcelt.sweep.DEFAULT_WIDTH)",
     )
     p.add_argument(
         "--host-devices",
@@ -116,7 +119,7 @@ def run(args) -> int:
     import jaxcelt as jc
     from jaxcelt.commands.simulate import parse_overrides
     from jaxcelt.dataset import open_sweep
-    from jaxcelt.sweep import orbit, parse_range, sweep
+    from jaxcelt.sweep import DEFAULT_WIDTH, orbit, parse_range, sweep
     from jaxcelt.versions import versions_string
 
     print(versions_string(), flush=True)
@@ -160,7 +163,7 @@ def run(args) -> int:
         "stop_on_invalid": bool(args.stop_on_invalid),
         "devices": [str(d) for d in jax.local_devices()],
         "chunk_size": args.chunk_size,
-        "width_per_device": args.width,
+        "width_per_device": args.width or DEFAULT_WIDTH,
         "wall_seconds_including_compile": round(wall, 2),
         "lanes_failed": int(np.sum(np.isin(ds["status"].values, (1, 3)))),  # status 2 = stopped invalid
         "lanes_invalid": int(np.sum(ds["valid"].values == 0)),
