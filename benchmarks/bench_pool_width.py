@@ -2,7 +2,9 @@
 
 400 lanes (omega_pi 10..20, from rest), 40 transient + 20 sampled periods, rtol 1e-8,
 stop-on-invalid, lanes sharded over all host CPU devices. Wider pools amortise per-kernel
-overhead but waste more slots in the final drain; prints one line per width and writes JSON.
+overhead but waste more slots in the final drain (which the pool narrows to 1/4, 1/16, ...
+of the width, down to 8 slots; slots are counted over all widths); prints one line per width
+and writes JSON.
 
     .venv/bin/python benchmarks/bench_pool_width.py --widths 16,32,64,128 --out docs/bifurcation
 """
