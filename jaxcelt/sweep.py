@@ -672,9 +672,10 @@ def _pool(
     # lanes not yet started), the running lanes are gathered into a pool a quarter as wide
     # and go on there (widths B, B/4, B/16, ... down to 8), so that the end of a chunk does
     # not pay for idle slots at the full width's cost. Per-lane results do not depend on the
-    # width (vectorised widths >= 4 give bitwise equal lanes; tested).
+    # width (vectorised widths >= 4 give bitwise equal lanes; tested). Each width compiles the
+    # step again (~8 s on CPU), so only pools with a queue (more lanes than slots) do this.
     widths = [B]
-    while widths[-1] // 4 >= 8:
+    while L > B and widths[-1] // 4 >= 8:
         widths.append(widths[-1] // 4)
     z = jnp.zeros((), jnp.int32)
     carry = (slots, lane, jnp.asarray(B, jnp.int32), out, z, z)
