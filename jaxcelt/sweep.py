@@ -421,13 +421,15 @@ def _erk_lane_step(
     The same algorithm as diffrax's loop body with ``PIDController`` (I-control, diffrax's
     defaults) inside ``ClipStepSizeController(step_ts=ts)``: stages k_i = dt f(t0 + c_i dt,
     y0 + sum_j a_ij k_j), y1 = y0 + sum b_i k_i, error sum e_i k_i, the RMS error ratio and
-    factor clip(0.9 err^(-1/(order+1)), [1, 10] if accepted else [0.2, 0.9]), the next step
+    factor clip(0.9 err^(-1/q), [1, 10] if accepted else [0.2, 0.9]) with q the error order
+    diffrax gives its controller (Tsit5 5, Dopri8 8), the next step
     clipped onto the next section time and onto t1. The last stage is f(t1, y1) (FSAL); its
     normal force and denominator feed the validity monitor, so monitoring costs no extra
     evaluation (diffrax's `MonitoredSolver` evaluates N once more per step). Without diffrax's
     generic stage loop, stage buffer and dense-output bookkeeping, XLA fuses the step into
-    fewer kernels (``benchmarks/bench_step_parts.py``). Lanes agree with `simulate` to
-    rounding (the arithmetic order differs), with the same step counts (tests).
+    fewer kernels (``benchmarks/bench_step_parts.py``). Tsit5 lanes agree with `simulate` to
+    rounding (the arithmetic order differs), with the same step counts (tests); Dopri8's
+    strongly cancelling error weights let rounding move a few steps (module docstring).
     ``boundary``: applied to every stage input (`_kernel_boundary`; identity by default).
     """
     R = diffrax.RESULTS
@@ -450,7 +452,7 @@ def _erk_lane_step(
     scaled = pid.norm(y_err / (pid.atol + jnp.maximum(jnp.abs(y0), jnp.abs(y1s)) * pid.rtol))
     keep = scaled < 1
     inv = 1 / scaled
-    order = cfg.solver.error_order(_pool_parts(cfg)[2])  # order + 1 for an ODE
+    order = cfg.solver.error_order(_pool_parts(cfg)[2])  # exactly what diffrax's controller is given
     factor = jnp.clip(
         pid.safety * inv ** (1.0 / order),
         jnp.where(keep, 1.0, pid.factormin),
@@ -552,20 +554,20 @@ def _pool(
     tols: Array,
     cfg: SweepConfig,
     width: int,
-    vary: tuple[bool, ...] | None = None,
-    opaque_true: Array | bool = True,
+    vary: tuple[bool, ...],
+    opaque_true: Array,
 ) -> dict[str, Array]:
     """All lanes of ``pb``/``y0b`` through ``width`` slots (refilled as lanes finish).
 
     ``live`` (L,) bool: False marks padding lanes, which finish at once and cost nothing.
-    ``vary`` (static, one flag per leaf of ``pb``; None = all): the parameters that differ
+    ``vary`` (static, one flag per leaf of ``pb``): the parameters that differ
     between lanes. Only those ride in the slots; the others enter the step as unbatched
     constants, so XLA computes what depends on them alone (inertia adjugate, elliptic
     integrals, b_Ts^m_Ts, ...) once instead of in every slot at every stage.
-    ``opaque_true``: a traced True (a jit argument) for `_kernel_boundary`.
+    ``opaque_true``: a traced True (a jit argument, not a Python bool: XLA would fold a
+    constant predicate and the boundary would vanish) for `_kernel_boundary`.
     """
     leaves, treedef = jax.tree_util.tree_flatten(pb)
-    vary = tuple(vary) if vary is not None else (True,) * len(leaves)
     const = [x[0] for x in leaves]
     pv_all = tuple(x for x, v in zip(leaves, vary) if v)
 

@@ -7,6 +7,7 @@ import subprocess
 import sys
 import textwrap
 
+import jax
 import numpy as np
 import pytest
 from _sweep_common import KW, VALUES
@@ -213,8 +214,9 @@ def test_pool_drain_compaction_keeps_lanes_bitwise(paper_params):
     y0 = np.tile(np.asarray(jc.initial_state(paper_params)), (len(vals), 1))
     pb = lanes_params(paper_params, "omega_pi", vals)
     cfg = SweepConfig(transient_periods=0, sample_periods=2, max_steps=4000)
-    wide = run_lanes(pb, y0, cfg, width=32, devices=jc.sweep.jax.local_devices()[:1])
-    narrow = run_lanes(pb, y0, cfg, width=8, devices=jc.sweep.jax.local_devices()[:1])
+    one = jax.local_devices()[:1]
+    wide = run_lanes(pb, y0, cfg, width=32, devices=one)
+    narrow = run_lanes(pb, y0, cfg, width=8, devices=one)
     it, paid = int(wide["pool_iterations"][0]), int(wide["pool_slot_steps"][0])
     assert paid < 32 * it  # the drain ran narrower
     assert paid >= int(wide["num_steps"].sum())
