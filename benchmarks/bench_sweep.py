@@ -3,8 +3,15 @@
 1. jaxcelt vmapped (`jaxcelt.bifurcation`: the lane pool, exact section times), with Tsit5 (the
    default) and with Dopri8 (the same 8th-order Dormand-Prince family as scipy's DOP853)
 2. jaxcelt one lane at a time (`jaxcelt.simulate` in a Python loop; subset, extrapolated)
-3. scipy ``solve_ivp(DOP853)`` with the numba RHS, lane by lane (subset, extrapolated)
+3. scipy ``solve_ivp(DOP853)`` with the numba RHS, lane by lane: stopping invalid lanes on
+   every lane (measured, no extrapolation; ``--scipy-stop-lanes``), integrating on from a subset
 4. numba hand-written adaptive Dormand-Prince 5(4) ensemble (prange over lanes; all lanes)
+
+Subset extrapolations weight the subset by each lane's cost: t_subset x (sum of jaxcelt's
+step counts over all lanes) / (sum over the subset), from the jaxcelt pool run doing the same
+work. Lane costs are heavy-tailed here (lanes that stay valid take ~8x the steps of lanes
+that stop), so the plain lane-count extrapolation (t_subset x lanes / subset, also reported)
+depends on which lanes the subset happens to hold.
 
 Same rtol/atol for all; accuracy of each checked on a few lanes over a short horizon
 against scipy DOP853 at rtol 1e-12 (chaotic lanes make long-horizon comparisons
@@ -33,6 +40,13 @@ import _numba_model as nm  # noqa: E402
 import jaxcelt as jc  # noqa: E402
 from jaxcelt.sweep import bifurcation  # noqa: E402
 from jaxcelt.versions import versions  # noqa: E402
+
+LANE_STEPS: dict = {}  # (stop_on_invalid, solver, devices) -> per-lane steps of a jaxcelt pool run
+
+
+def weighted_extrapolation(t_subset, sub, weights):
+    """Cost-weighted (ratio) extrapolation of a subset timing to all lanes."""
+    return float(t_subset * weights.sum() / weights[sub].sum())
 
 
 def lane_setup(p, vals, transient, sample):
@@ -113,6 +127,7 @@ def time_jaxcelt(p, vals, transient, a, scheduler, stop, devices, solver=None):
         slots = ndev * int(sum(int(c["pool_slot_steps"][0]) for c in chunks))
     else:
         slots = int(sum(int(c["num_steps"].max()) * len(c["num_steps"]) for c in chunks))
+    LANE_STEPS[(stop, type(solver).__name__, ndev)] = np.asarray(r.num_steps, dtype=float)
     per_period = r.num_steps / (transient + a.sample)
     inval = ~r.valid
     # RHS evaluations per step: the tableau's stages less the first (FSAL): Tsit5 6, Dopri8 13.
@@ -172,17 +187,30 @@ def _numba_ensemble(Y0, TS, PP, B, Bi, a, stop):
     )
 
 
-def _scipy_subset(PP, B, Bi, TS, Y0, sub, a, stop):
-    t = time.perf_counter()
+def _scipy_lanes(PP, B, Bi, TS, Y0, lanes, a, stop, weights):
+    """scipy loop over ``lanes`` (all lanes: measured; a subset: extrapolated, cost-weighted)."""
+    per = np.zeros(len(lanes))
     nfev = 0
-    for k in sub:
-        _, nf, _ = scipy_lane(Y0[k], TS[k], PP[k], B, Bi, a.rtol, a.atol, stop_invalid=stop)
+    status = []
+    for i, k in enumerate(lanes):
+        t = time.perf_counter()
+        _, nf, stt = scipy_lane(Y0[k], TS[k], PP[k], B, Bi, a.rtol, a.atol, stop_invalid=stop)
+        per[i] = time.perf_counter() - t
         nfev += nf
-    t_sp = time.perf_counter() - t
-    return dict(
-        subset_seconds=t_sp, lanes=len(sub), extrapolated_seconds=t_sp * len(PP) / len(sub), rhs_evals=nfev,
-        us_per_rhs=t_sp / nfev * 1e6,
-    )  # fmt: skip
+        status.append(int(stt))
+    t_sp = float(per.sum())
+    n = len(PP)
+    out = dict(lanes=len(lanes), seconds_of_these_lanes=t_sp, rhs_evals=nfev, us_per_rhs=t_sp / nfev * 1e6)
+    if len(lanes) == n:
+        out.update(seconds=t_sp, measured_all_lanes=True)
+        out["solver_status_counts"] = {int(k): int(v) for k, v in zip(*np.unique(status, return_counts=True))}
+    else:
+        out.update(
+            seconds=weighted_extrapolation(t_sp, np.asarray(lanes), weights),
+            measured_all_lanes=False,
+            extrapolated_by_lane_count=t_sp * n / len(lanes),
+        )  # fmt: skip
+    return out, per
 
 
 def main():
@@ -197,6 +225,10 @@ def main():
     ap.add_argument("--host-devices", default="auto", help="CPU JAX devices to shard lanes over ('auto' = CPU cores)")
     ap.add_argument("--with-chunks", action="store_true", help="also time the old chunk scheduler")
     ap.add_argument("--subset", type=int, default=8, help="lanes (evenly spread) for the lane-by-lane methods")
+    ap.add_argument(
+        "--scipy-stop-lanes", default="all",
+        help="'all' (measure the scipy loop stopping invalid lanes on every lane) or 'subset' (extrapolate)",
+    )  # fmt: skip
     ap.add_argument("--quick", action="store_true", help="40 freq x 40 periods")
     ap.add_argument("--out", type=Path, default=Path("docs/bifurcation"))
     a = ap.parse_args()
@@ -275,13 +307,23 @@ def main():
     for k in sub:
         jax.block_until_ready(f1(p.replace(omega_pi=float(vals[k])), Y0[k], TS[k]))
     t1 = time.perf_counter() - t
+    # weights: per-lane steps of the jaxcelt pool run doing the same work (Tsit5, all devices)
+    w_on, w_stop = LANE_STEPS[(False, "Tsit5", len(devs))], LANE_STEPS[(True, "Tsit5", len(devs))]
     res["jaxcelt_lane_by_lane"] = dict(
-        subset_seconds=t1, lanes=len(sub), extrapolated_seconds=t1 * a.n_freq / len(sub), compile_seconds=t_c1
-    )
+        subset_seconds=t1, lanes=len(sub), compile_seconds=t_c1,
+        seconds=weighted_extrapolation(t1, sub, w_on),  # simulate integrates invalid lanes on
+        extrapolated_by_lane_count=t1 * a.n_freq / len(sub),
+    )  # fmt: skip
     print("jaxcelt lane by lane", res["jaxcelt_lane_by_lane"], flush=True)
+    all_stop = a.scipy_stop_lanes == "all"
     for stop in (True, False):
         key = "scipy_dop853_numba_rhs" + ("_stop_on_invalid" if stop else "")
-        res[key] = _scipy_subset(PP, B, Bi, TS, Y0, sub, a, stop)
+        lanes = np.arange(a.n_freq) if (stop and all_stop) else sub
+        res[key], per = _scipy_lanes(PP, B, Bi, TS, Y0, lanes, a, stop, w_stop if stop else w_on)
+        if stop and all_stop:
+            # what the subset would have said, from the same per-lane timings
+            res[key]["subset_extrapolated_by_lane_count"] = float(per[sub].sum() * a.n_freq / len(sub))
+            res[key]["subset_extrapolated_cost_weighted"] = weighted_extrapolation(per[sub].sum(), sub, w_stop)
         print(key, res[key], flush=True)
 
     # accuracy: 5 periods, subset lanes, vs scipy DOP853 rtol 1e-12 (longer horizons are
@@ -314,13 +356,14 @@ def main():
         total_with_compile_s=js["seconds"] + js["compile_seconds"],
         target_120s_met=bool(js["seconds"] + js["compile_seconds"] <= 120) if (a.n_freq, a.periods) == (400, 300) else None,
         # same work: both stop invalid lanes / both integrate every lane to the end
-        speedup_vs_scipy_loop_same_work_stop=ss["extrapolated_seconds"] / js["seconds"],
+        scipy_stop_measured_on_all_lanes=ss["measured_all_lanes"],
+        speedup_vs_scipy_loop_same_work_stop=ss["seconds"] / js["seconds"],
         jaxcelt_dopri8_stop_on_invalid_s=j8["seconds"],
-        speedup_vs_scipy_loop_same_work_stop_dopri8=ss["extrapolated_seconds"] / j8["seconds"],
+        speedup_vs_scipy_loop_same_work_stop_dopri8=ss["seconds"] / j8["seconds"],
         per_rhs_ratio_jaxcelt_dopri8_vs_numba=j8["core_us_per_rhs"] / ns["us_per_rhs_cpu"],
-        speedup_vs_scipy_loop_same_work_integrate_on=sv["extrapolated_seconds"] / jv["seconds"],
-        speedup_vs_scipy_loop_integrating_on=sv["extrapolated_seconds"] / js["seconds"],
-        speedup_vs_jaxcelt_lane_by_lane=res["jaxcelt_lane_by_lane"]["extrapolated_seconds"] / js["seconds"],
+        speedup_vs_scipy_loop_same_work_integrate_on=sv["seconds"] / jv["seconds"],
+        speedup_vs_scipy_loop_integrating_on=sv["seconds"] / js["seconds"],
+        speedup_vs_jaxcelt_lane_by_lane=res["jaxcelt_lane_by_lane"]["seconds"] / js["seconds"],
         wall_ratio_vs_numba_ensemble_stop=js["seconds"] / ns["seconds"],
         wall_ratio_vs_numba_ensemble_integrate_on=jv["seconds"] / nv["seconds"],
         core_us_per_rhs_jaxcelt=js["core_us_per_rhs"],
@@ -347,8 +390,8 @@ def main():
         rows.append(("jaxcelt chunks\n(old)", None, res["jaxcelt_chunks"]["seconds"], "tab:gray"))
     rows += [
         (f"numba DP5\nensemble ({ns['threads']} thr)", ns["seconds"], nv["seconds"], "tab:green"),
-        ("jaxcelt lane\nby lane*", None, res["jaxcelt_lane_by_lane"]["extrapolated_seconds"], "tab:purple"),
-        ("scipy DOP853\n+ numba RHS*", ss["extrapolated_seconds"], sv["extrapolated_seconds"], "tab:orange"),
+        ("jaxcelt lane\nby lane*", None, res["jaxcelt_lane_by_lane"]["seconds"], "tab:purple"),
+        ("scipy DOP853\n+ numba RHS*", ss["seconds"], sv["seconds"], "tab:orange"),
     ]
     fig, ax = plt.subplots(figsize=(10, 4.8), constrained_layout=True)
     x = np.arange(len(rows))
@@ -368,7 +411,9 @@ def main():
     ax.set_ylabel("wall time [s], compile excluded (log)")
     ax.set_title(
         f"{a.n_freq} frequencies x {a.periods} periods, rtol {a.rtol:g}, {os.cpu_count()} CPU cores "
-        f"(load {load[0]:.1f} at start)\n* extrapolated from {len(sub)} evenly spread lanes, full length; "
+        f"(load {load[0]:.1f} at start)\n* "
+        + ("stop: all lanes measured; integrate on: " if ss["measured_all_lanes"] else "")
+        + f"extrapolated from {len(sub)} evenly spread full-length lanes (cost-weighted); "
         f"jax {jax.__version__}, diffrax {V.get('diffrax', '?')}",
         fontsize=10,
     )

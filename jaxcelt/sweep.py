@@ -670,15 +670,15 @@ def _pool(
         slots = jax.lax.cond(jnp.any(refill), do_refill, lambda s: s, slots)
         return slots, lane, nxt, out, iters + 1, slot_steps + lane.shape[0]
 
-    # The drain: once no more than a quarter of the slots have work left (running lanes plus
-    # lanes not yet started), the running lanes are gathered into a pool a quarter as wide
-    # and go on there (widths B, B/4, B/16, ... down to 8), so that the end of a chunk does
-    # not pay for idle slots at the full width's cost. Per-lane results do not depend on the
-    # width (vectorised widths >= 4 give bitwise equal lanes; tested). Each width compiles the
-    # step again (~8 s on CPU), so only pools with a queue (more lanes than slots) do this.
+    # The drain: once no more than half of the slots have work left (running lanes plus lanes
+    # not yet started), the running lanes are gathered into a pool half as wide and go on
+    # there (widths B, B/2, B/4, ... down to 16), so that the end of a chunk does not pay for
+    # idle slots at the full width's cost. Per-lane results do not depend on the width
+    # (vectorised widths >= 4 give bitwise equal lanes; tested). Each width compiles the step
+    # again (~9 s on CPU), so only pools with a queue (more lanes than slots) do this.
     widths = [B]
-    while L > B and widths[-1] // 4 >= 8:
-        widths.append(widths[-1] // 4)
+    while L > B and widths[-1] // 2 >= MIN_DRAIN_WIDTH:
+        widths.append(widths[-1] // 2)
     z = jnp.zeros((), jnp.int32)
     carry = (slots, lane, jnp.asarray(B, jnp.int32), out, z, z)
     for nxt_w in [*widths[1:], 0]:
@@ -764,6 +764,7 @@ def _pad(x: np.ndarray, n: int) -> np.ndarray:
 
 SCHEDULERS = ("pool", "chunks")
 DEFAULT_WIDTH = 64
+MIN_DRAIN_WIDTH = 16  # narrowest pool of the drain (narrower costs more per slot than it saves)
 """pool slots per device (``benchmarks/bench_pool_width.py``: 64 was fastest for 400 lanes on 2 cores)"""
 
 

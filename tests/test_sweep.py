@@ -205,7 +205,7 @@ def test_pool_other_solvers_equal_simulate(paper_params, solver):
 
 
 def test_pool_drain_compaction_keeps_lanes_bitwise(paper_params):
-    # 40 lanes through 32 slots: once <= 8 lanes are left the pool continues 8 wide
+    # 40 lanes through 32 slots: once <= 16 lanes are left the pool continues 16 wide
     # (`_pool`'s drain). Lanes must not depend on the width they ran at: compare with a
     # pool that is 8 wide from the start (bitwise; vectorised widths give identical lanes).
     from jaxcelt.sweep import SweepConfig, run_lanes
