@@ -88,7 +88,7 @@ def scipy_lane(y0, ts, P, B, Bi, rtol, atol, stop_invalid=False):
     return ys, sol.nfev, sol.status
 
 
-def time_jaxcelt(p, vals, transient, a, scheduler, stop, devices, solver=None):
+def time_jaxcelt(p, vals, transient, a, scheduler, stop, devices, solver=None, reps=1):
     """Compile apart, then the sweep; step-slot accounting from the pool's loop counters."""
     import diffrax
 
@@ -116,15 +116,21 @@ def time_jaxcelt(p, vals, transient, a, scheduler, stop, devices, solver=None):
         bifurcation(p, vals[:cs], transient_periods=0, **kw)
         compile_note = "compile + a sample-periods-only run of one chunk"
     t_compile = time.perf_counter() - t
-    chunks = []
-    t = time.perf_counter()
-    r = bifurcation(p, vals, transient_periods=transient, on_chunk=lambda ci, c: chunks.append(c), **kw)
-    t_run = time.perf_counter() - t
+    runs = []
+    for _ in range(reps):  # identical runs (deterministic lanes); the median time is reported
+        chunks = []
+        t = time.perf_counter()
+        r = bifurcation(
+            p, vals, transient_periods=transient, on_chunk=lambda ci, c, chunks=chunks: chunks.append(c), **kw
+        )
+        runs.append(time.perf_counter() - t)
+    t_run = float(np.median(runs))
     useful = int(r.num_steps.sum())
     ndev = len(devices)
     if scheduler == "pool":
-        # every device runs its own pool; pool_slot_steps counts its slots over all drain widths
-        slots = ndev * int(sum(int(c["pool_slot_steps"][0]) for c in chunks))
+        # every device runs its own pool; pool_slot_steps counts its slots over all drain widths;
+        # lanes are dealt round-robin, so a chunk's lane d ran on device d
+        slots = int(sum(int(c["pool_slot_steps"][:ndev].sum()) for c in chunks))
     else:
         slots = int(sum(int(c["num_steps"].max()) * len(c["num_steps"]) for c in chunks))
     LANE_STEPS[(stop, type(solver).__name__, ndev)] = np.asarray(r.num_steps, dtype=float)
@@ -138,6 +144,7 @@ def time_jaxcelt(p, vals, transient, a, scheduler, stop, devices, solver=None):
         rhs_per_step=ne,
         devices=ndev,
         seconds=t_run,
+        seconds_each_run=runs,
         compile_seconds=t_compile,
         compile_note=compile_note,
         total_steps=useful,
@@ -171,13 +178,17 @@ def eval_costs(p, vals, width, reps=2000):
     return res
 
 
-def _numba_ensemble(Y0, TS, PP, B, Bi, a, stop):
-    t = time.perf_counter()
-    _, st, ev, status = nm.dopri_ensemble(Y0, TS, PP, B, Bi, a.rtol, a.atol, 10**6, stop)  # = jaxcelt max_steps
-    t_nb = time.perf_counter() - t
+def _numba_ensemble(Y0, TS, PP, B, Bi, a, stop, reps=1):
+    runs = []
+    for _ in range(reps):
+        t = time.perf_counter()
+        _, st, ev, status = nm.dopri_ensemble(Y0, TS, PP, B, Bi, a.rtol, a.atol, 10**6, stop)  # = jaxcelt max_steps
+        runs.append(time.perf_counter() - t)
+    t_nb = float(np.median(runs))
     th = nm.nb.get_num_threads()
     return dict(
         seconds=t_nb,
+        seconds_each_run=runs,
         total_steps=int(st.sum()),
         rhs_evals=int(ev.sum()),
         us_per_rhs_wall=t_nb / ev.sum() * 1e6,
@@ -230,6 +241,11 @@ def main():
         help="'all' (measure the scipy loop stopping invalid lanes on every lane) or 'subset' (extrapolate)",
     )  # fmt: skip
     ap.add_argument("--quick", action="store_true", help="40 freq x 40 periods")
+    ap.add_argument(
+        "--reps", type=int, default=3,
+        help="runs of each stop-at-invalid jaxcelt / numba timing (median reported: this VM's speed drifts by "
+        "10-20 %% between minutes); the slower integrate-on and lane-by-lane timings run once",
+    )  # fmt: skip
     ap.add_argument("--out", type=Path, default=Path("docs/bifurcation"))
     a = ap.parse_args()
     n_host = (os.cpu_count() or 1) if a.host_devices == "auto" else int(a.host_devices)
@@ -283,7 +299,7 @@ def main():
     if a.with_chunks:
         runs.append(("chunks", "chunks", False, devs, None))
     for key, sched, stop, dv, solver in runs:
-        res[f"jaxcelt_{key}"] = time_jaxcelt(p, vals, transient, a, sched, stop, dv, solver)
+        res[f"jaxcelt_{key}"] = time_jaxcelt(p, vals, transient, a, sched, stop, dv, solver, a.reps if stop else 1)
         print(key, res[f"jaxcelt_{key}"], flush=True)
     res["per_lane_eval_cost"] = eval_costs(p, vals, a.width)
     print("per-lane evaluation cost (vmapped, one device)", res["per_lane_eval_cost"], flush=True)
@@ -293,7 +309,7 @@ def main():
     nm.dopri_ensemble(Y0[:2].copy(), TS[:2, :1].copy(), PP[:2].copy(), B, Bi, a.rtol, a.atol, 10**7, True)
     for stop in (True, False):
         key = "numba_dp5_ensemble" + ("_stop_on_invalid" if stop else "")
-        res[key] = _numba_ensemble(Y0, TS, PP, B, Bi, a, stop)
+        res[key] = _numba_ensemble(Y0, TS, PP, B, Bi, a, stop, a.reps if stop else 1)
         print(key, res[key], flush=True)
 
     # 3. lane by lane on an evenly spread subset, full length, extrapolated to all lanes
