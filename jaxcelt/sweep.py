@@ -1119,6 +1119,7 @@ def orbit(
     transient_periods: int = 200,
     periods: int = 40,
     points_per_period: int = 40,
+    solver: diffrax.AbstractSolver | None = None,
     rtol: float = 1e-8,
     atol: float = 1e-10,
     max_steps: int = 1_000_000,
@@ -1139,8 +1140,9 @@ def orbit(
     k = np.arange(periods * points_per_period + 1)
     ts = T * (transient_periods + k / points_per_period)
     sol = simulate(
-        params, y0, ts[-1], ts=ts, rtol=rtol, atol=atol, max_steps=max_steps, contact_law=contact_law, exact_ts=True
-    )
+        params, y0, ts[-1], ts=ts, solver=solver, rtol=rtol, atol=atol, max_steps=max_steps,
+        contact_law=contact_law, exact_ts=True,
+    )  # fmt: skip
     ys = np.asarray(sol.ys)
     r_O = np.asarray(jax.vmap(centre_position, in_axes=(0, None))(sol.ys, params))
     return dict(

@@ -49,3 +49,37 @@ def test_compile_cache_is_written(tmp_path):
     cmd = [sys.executable, "-m", "jaxcelt", "simulate", "--omega-pi", "17", "--periods", "1", "--out", str(tmp_path)]
     subprocess.run(cmd, env=env, check=True, capture_output=True)
     assert cache.is_dir() and any(cache.iterdir())
+
+
+def test_bifurcation_solver_option(tmp_path):
+    # --solver reaches the sweep: the dataset records it, and the lanes equal a Python-API sweep
+    # with that solver (1e-10: the pool-vs-simulate agreement; the device count may differ, which
+    # changes the compiled program and so the rounding, ~1e-11 over a few periods).
+    from jaxcelt.dataset import open_sweep
+
+    out = tmp_path / "run"
+    cmd = [sys.executable, "-m", "jaxcelt", "bifurcation", "--omega", "14,17", "--transient", "1", "--sample", "2",
+           "--lyapunov", "0", "--orbits", "", "--solver", "Dopri5", "--host-devices", "1", "--no-figures",
+           "--out", str(out)]  # fmt: skip
+    subprocess.run(cmd, check=True, capture_output=True, env=dict(os.environ, JAXCELT_CACHE_DIR="off"))
+    ds = open_sweep(out)
+    assert json.loads(ds.attrs["config_json"])["solver"] == "Dopri5"
+    assert json.loads((out / "summary.json").read_text())["solver"] == "Dopri5"
+    import diffrax
+
+    import jaxcelt as jc
+
+    p = jc.CeltParams.paper()
+    r = jc.bifurcation(p, [14.0, 17.0], transient_periods=1, sample_periods=2, solver=diffrax.Dopri5(),
+                       stop_on_invalid=True)  # fmt: skip
+    np.testing.assert_allclose(ds["section"].values, r.samples, rtol=0, atol=1e-10)
+    np.testing.assert_array_equal(ds["num_steps"].values, r.num_steps)
+
+
+def test_bifurcation_rejects_unknown_solver(capsys):
+    import pytest
+
+    with pytest.raises(SystemExit) as e:
+        main(["bifurcation", "--solver", "RK45"])
+    assert e.value.code == 2
+    assert "invalid choice: 'RK45'" in capsys.readouterr().err

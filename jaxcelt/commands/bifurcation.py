@@ -12,6 +12,8 @@ import json
 import time
 from pathlib import Path
 
+SWEEP_SOLVERS = ("Tsit5", "Dopri5", "Dopri8")  # names in jaxcelt.benchmarking.SOLVERS
+
 
 def register(sub) -> None:
     p = sub.add_parser(
@@ -34,6 +36,14 @@ def register(sub) -> None:
         "--set", action="append", default=[], metavar="NAME=VALUE", help="override any CeltParams field, repeatable"
     )
     p.add_argument("--omega0", default="0,0,0", help="initial omega (body) [rad/s]")
+    p.add_argument(
+        "--solver",
+        default="Tsit5",
+        choices=SWEEP_SOLVERS,
+        help="explicit Runge-Kutta method (adaptive, PID control, section times hit exactly). Dopri8 is the same "
+        "8th-order Dormand-Prince family as scipy's DOP853: at rtol 1e-8 about 25x more accurate than Tsit5, "
+        "as fast per sweep, but it compiles longer",
+    )
     p.add_argument("--rtol", type=float, default=1e-8)
     p.add_argument("--atol", type=float, default=1e-10)
     p.add_argument("--max-steps", type=int, default=1_000_000)
@@ -117,6 +127,7 @@ def run(args) -> int:
     import numpy as np
 
     import jaxcelt as jc
+    from jaxcelt.benchmarking import make_solver
     from jaxcelt.commands.simulate import parse_overrides
     from jaxcelt.dataset import open_sweep
     from jaxcelt.sweep import DEFAULT_WIDTH, orbit, parse_range, sweep
@@ -139,6 +150,7 @@ def run(args) -> int:
         sample_periods=args.sample,
         lyapunov_periods=args.lyapunov,
         y0=y0,
+        solver=make_solver(args.solver),
         rtol=args.rtol,
         atol=args.atol,
         max_steps=args.max_steps,
@@ -158,6 +170,7 @@ def run(args) -> int:
         "transient_periods": args.transient,
         "sample_periods": args.sample,
         "lyapunov_periods": args.lyapunov,
+        "solver": args.solver,
         "rtol": args.rtol,
         "atol": args.atol,
         "stop_on_invalid": bool(args.stop_on_invalid),
@@ -195,6 +208,7 @@ def run(args) -> int:
                 jc.initial_state(pw, omega=omega0),
                 transient_periods=args.transient,
                 periods=args.orbit_periods,
+                solver=make_solver(args.solver),
                 rtol=args.rtol,
                 atol=args.atol,
             )
