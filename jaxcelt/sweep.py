@@ -677,8 +677,8 @@ def _pool(
     # (vectorised widths >= 4 give bitwise equal lanes; tested). Each width compiles the step
     # again (~9 s on CPU), so only pools with a queue (more lanes than slots) do this.
     widths = [B]
-    while L > B and widths[-1] // DRAIN_FACTOR >= MIN_DRAIN_WIDTH:
-        widths.append(widths[-1] // DRAIN_FACTOR)
+    while L > B and widths[-1] // 2 >= MIN_DRAIN_WIDTH:
+        widths.append(widths[-1] // 2)
     z = jnp.zeros((), jnp.int32)
     carry = (slots, lane, jnp.asarray(B, jnp.int32), out, z, z)
     for nxt_w in [*widths[1:], 0]:
@@ -765,7 +765,6 @@ def _pad(x: np.ndarray, n: int) -> np.ndarray:
 SCHEDULERS = ("pool", "chunks")
 DEFAULT_WIDTH = 64
 MIN_DRAIN_WIDTH = 16  # narrowest pool of the drain (narrower costs more per slot than it saves)
-DRAIN_FACTOR = 2  # the drain narrows the pool by this factor at a time
 """pool slots per device (``benchmarks/bench_pool_width.py``: 64 was fastest for 400 lanes on 2 cores)"""
 
 

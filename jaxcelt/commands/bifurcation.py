@@ -141,6 +141,7 @@ def run(args) -> int:
     omega0 = [float(x) for x in args.omega0.split(",")]
     y0 = np.asarray(jc.initial_state(params, omega=omega0))
     args.out.mkdir(parents=True, exist_ok=True)
+    solver = make_solver(args.solver)
     t0 = time.perf_counter()
     sweep(
         params,
@@ -150,7 +151,7 @@ def run(args) -> int:
         sample_periods=args.sample,
         lyapunov_periods=args.lyapunov,
         y0=y0,
-        solver=make_solver(args.solver),
+        solver=solver,
         rtol=args.rtol,
         atol=args.atol,
         max_steps=args.max_steps,
@@ -208,7 +209,7 @@ def run(args) -> int:
                 jc.initial_state(pw, omega=omega0),
                 transient_periods=args.transient,
                 periods=args.orbit_periods,
-                solver=make_solver(args.solver),
+                solver=solver,
                 rtol=args.rtol,
                 atol=args.atol,
             )
