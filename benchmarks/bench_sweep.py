@@ -128,9 +128,8 @@ def time_jaxcelt(p, vals, transient, a, scheduler, stop, devices, solver=None, r
     useful = int(r.num_steps.sum())
     ndev = len(devices)
     if scheduler == "pool":
-        # every device runs its own pool; pool_slot_steps counts its slots over all drain widths;
-        # lanes are dealt round-robin, so a chunk's lane d ran on device d
-        slots = int(sum(int(c["pool_slot_steps"][:ndev].sum()) for c in chunks))
+        # pool_slot_steps: the step slots a chunk paid, summed over its devices and drain widths
+        slots = int(sum(int(c["pool_slot_steps"][0]) for c in chunks))
     else:
         slots = int(sum(int(c["num_steps"].max()) * len(c["num_steps"]) for c in chunks))
     LANE_STEPS[(stop, type(solver).__name__, ndev)] = np.asarray(r.num_steps, dtype=float)
@@ -232,7 +231,9 @@ def main():
     ap.add_argument("--rtol", type=float, default=1e-8)
     ap.add_argument("--atol", type=float, default=1e-10)
     ap.add_argument("--chunk-size", type=int, default=400, help="lanes per pool launch (resumable unit)")
-    ap.add_argument("--width", type=int, default=64, help="pool slots per device (vmap width; the library default)")
+    ap.add_argument(
+        "--width", type=int, default=None, help="pool slots per device (vmap width; default: the library's DEFAULT_WIDTH)"
+    )
     ap.add_argument("--host-devices", default="auto", help="CPU JAX devices to shard lanes over ('auto' = CPU cores)")
     ap.add_argument("--with-chunks", action="store_true", help="also time the old chunk scheduler")
     ap.add_argument("--subset", type=int, default=8, help="lanes (evenly spread) for the lane-by-lane methods")
@@ -248,6 +249,10 @@ def main():
     )  # fmt: skip
     ap.add_argument("--out", type=Path, default=Path("docs/bifurcation"))
     a = ap.parse_args()
+    if a.width is None:
+        from jaxcelt.sweep import DEFAULT_WIDTH
+
+        a.width = DEFAULT_WIDTH
     n_host = (os.cpu_count() or 1) if a.host_devices == "auto" else int(a.host_devices)
     jax.config.update("jax_num_cpu_devices", n_host)  # before the first JAX operation
     if a.quick:

@@ -25,8 +25,13 @@ Execution model
   slot assignment) is fixed and the per-lane arithmetic does not depend on the slot, so
   results are deterministic and a lane's result does not depend on its neighbours (a lane
   that hits ``max_steps`` is flagged and the others are bitwise unchanged).
+  When lanes queue for slots, every lane first runs a tenth of its time span
+  (`PILOT_FRACTION`) and pauses between two steps; paused lanes wait with their predicted
+  remaining cost (steps so far x remaining / elapsed span) and free slots take them costliest
+  first (longest-processing-time order), so the drain runs on short lanes. A pause does not
+  change a lane: it resumes with the same state and step sequence (tested bitwise).
   ``sort_by_cost=True`` orders lanes by the cost proxy 1/omega_pi (time span of a period),
-  longest first, so the drain runs on cheap lanes. The optional Lyapunov stage then runs
+  longest first. The optional Lyapunov stage then runs
   vmapped over the successful lanes in groups of ``width`` ordered by the measured
   main-solve step count.
 * ``scheduler="chunks"`` (the previous engine): a chunk is one ``jax.vmap`` of `simulate`;
@@ -546,27 +551,13 @@ def _lane_status(st: dict[str, Any]) -> Array:
     return jnp.where(ok, jnp.where(st["tprev"] >= st["t1"], 0, 1), status_code(st["result"])).astype(jnp.int32)
 
 
-def _pool(
-    pb: CeltParams,
-    y0b: Array,
-    live: Array,
-    transient: Array,
-    tols: Array,
-    cfg: SweepConfig,
-    width: int,
-    vary: tuple[bool, ...],
-    opaque_true: Array,
-) -> dict[str, Array]:
-    """All lanes of ``pb``/``y0b`` through ``width`` slots (refilled as lanes finish).
+def _param_split(pb: CeltParams, vary: tuple[bool, ...]) -> tuple[tuple[Array, ...], Callable[[Any], CeltParams]]:
+    """(the lane-varying leaves of ``pb``, a function rebuilding one lane's params from them).
 
-    ``live`` (L,) bool: False marks padding lanes, which finish at once and cost nothing.
-    ``vary`` (static, one flag per leaf of ``pb``): the parameters that differ
-    between lanes. Only those ride in the slots; the others enter the step as unbatched
-    constants, so XLA computes what depends on them alone (inertia adjugate, elliptic
-    integrals, b_Ts^m_Ts, ...) once instead of in every slot at every stage.
-    ``opaque_true``: a traced True (a jit argument, not a Python bool: XLA would fold a
-    constant predicate and the boundary would vanish) for `_kernel_boundary`.
-    """
+    ``vary`` (static, one flag per leaf of ``pb``): the parameters that differ between lanes.
+    Only those ride in the slots; the others enter the step as unbatched constants, so XLA
+    computes what depends on them alone (inertia adjugate, elliptic integrals, b_Ts^m_Ts, ...)
+    once instead of in every slot at every stage."""
     leaves, treedef = jax.tree_util.tree_flatten(pb)
     const = [x[0] for x in leaves]
     pv_all = tuple(x for x, v in zip(leaves, vary) if v)
@@ -575,17 +566,66 @@ def _pool(
         it = iter(pv)
         return jax.tree_util.tree_unflatten(treedef, [next(it) if v else c for v, c in zip(vary, const)])
 
-    L = y0b.shape[0]
-    B = min(width, L)
-    S = cfg.sample_periods
-    t0 = jnp.asarray(cfg.t0, jnp.float64)
+    return pv_all, params_of
+
+
+def _section_times(pb: CeltParams, transient: Array, cfg: SweepConfig) -> Array:
+    """(L, S) stroboscopic times t0 + k 2 pi / omega_pi, k = transient, transient + 1, ..."""
     T = 2 * jnp.pi / pb.omega_pi
-    ts_all = t0 + T[:, None] * (transient + jnp.arange(S, dtype=jnp.float64))[None, :]
+    S = cfg.sample_periods
+    return jnp.asarray(cfg.t0, jnp.float64) + T[:, None] * (transient + jnp.arange(S, dtype=jnp.float64))[None, :]
 
-    def _init(pv, y, ts, lv):
-        st = _lane_init(cfg, params_of(pv), y, ts, tols)
-        return dict(st, p=pv, done=st["done"] | ~lv, at_t0=st["k"] > 0)
 
+_SLOT_ONLY = ("p", "ts")  # slot fields rebuilt from the lane's parameters, not stored per lane
+
+
+def _init_lanes(
+    pb: CeltParams, y0b: Array, live: Array, transient: Array, tols: Array, cfg: SweepConfig, vary: tuple[bool, ...]
+) -> tuple[dict[str, Array], Array]:
+    """Every lane's starting state (diffeqsolve's initialisation) and the samples buffer.
+
+    ``live`` (L,) bool: False marks padding lanes, which start done. A section time at t0
+    (transient 0) is the initial state itself: written here."""
+    pv_all, params_of = _param_split(pb, vary)
+    ts_all = _section_times(pb, transient, cfg)
+    st = jax.vmap(lambda pv, y, ts: _lane_init(cfg, params_of(pv), y, ts, tols))(pv_all, y0b, ts_all)
+    ls = {k: v for k, v in st.items() if k not in _SLOT_ONLY}
+    ls["done"] = ls["done"] | ~live
+    ls["resumed"] = jnp.zeros_like(ls["done"])  # paused once and taken up again (pauses only once)
+    L, S = y0b.shape[0], cfg.sample_periods
+    samples = jnp.full((L, S, 13), jnp.inf).at[:, 0].set(jnp.where((ls["k"] > 0)[:, None], y0b, jnp.inf))
+    return ls, samples
+
+
+def _pool(
+    pb: CeltParams,
+    ls: dict[str, Array],
+    samples: Array,
+    queue: Array,
+    n_queue: Array,
+    pause_frac: Array,
+    transient: Array,
+    cfg: SweepConfig,
+    width: int,
+    vary: tuple[bool, ...],
+    opaque_true: Array,
+) -> tuple[dict[str, Array], Array, Array, Array]:
+    """Lanes ``queue[:n_queue]`` through ``width`` slots (refilled as lanes finish).
+
+    ``ls``: every lane's state (`_init_lanes`, or a previous pool's output); a lane is taken
+    from it when a slot is free and written back when it is done or paused. A lane pauses at
+    the end of its first step past t0 + ``pause_frac`` (t1 - t0) (inf: never): it stops
+    between two steps, so resuming it from ``ls`` continues the very same step sequence.
+    ``samples`` (L, S, 13): the section buffer, written in place. ``vary``: see
+    `_param_split`. ``opaque_true``: a traced True (a jit argument, not a Python bool: XLA
+    would fold a constant predicate and the boundary would vanish) for `_kernel_boundary`.
+    Returns (ls, samples, loop iterations, step slots paid).
+    """
+    pv_all, params_of = _param_split(pb, vary)
+    L = samples.shape[0]
+    B = min(width, L)
+    ts_all = _section_times(pb, transient, cfg)
+    t0 = jnp.asarray(cfg.t0, jnp.float64)
     tab = _erk_tableau(cfg)
 
     def _step(st):
@@ -595,80 +635,63 @@ def _pool(
             new, hit = _lane_step(cfg, st)
         else:
             new, hit = _erk_lane_step(cfg, tab, st, _kernel_boundary(jnp.asarray(opaque_true)))
-        return dict(new, p=pv), hit
+        paused = ~new["done"] & ~st["resumed"] & (new["tprev"] >= t0 + pause_frac * (new["t1"] - t0))
+        return dict(new, p=pv), hit, paused
 
-    init_v = jax.vmap(_init)
     step_v = jax.vmap(_step)
 
-    def take(idx):
-        j = jnp.minimum(idx, L - 1)
-        return tuple(x[j] for x in pv_all), y0b[j], ts_all[j], live[j]
+    def take(lane, ls):
+        j = jnp.minimum(lane, L - 1)
+        st = jax.tree_util.tree_map(lambda x: x[j], ls)
+        return dict(st, p=tuple(x[j] for x in pv_all), ts=ts_all[j])
 
-    out = dict(
-        samples=jnp.full((L, S, 13), jnp.inf),
-        y_final=jnp.full((L, 13), jnp.nan),
-        status=jnp.full((L,), 3, jnp.int32),
-        num_steps=jnp.zeros((L,), jnp.int32),
-        first_invalid_t=jnp.full((L,), jnp.inf),
-        first_invalid_kind=jnp.zeros((L,), jnp.int32),
-        min_N=jnp.full((L,), jnp.nan),
-        max_tilt=jnp.full((L,), jnp.nan),
-    )
+    def lane_at(pos):
+        return jnp.where(pos < n_queue, queue[jnp.minimum(pos, L - 1)], L).astype(jnp.int32)
 
-    def write_initial(out, lane, st):
-        # section time at t0 (transient 0): the sample is y0. Written in the loop body (not in
-        # the refill branch) so that the big output buffers are only ever updated in place.
-        w = jnp.where((lane < L) & st["at_t0"], lane, L)
-        out["samples"] = out["samples"].at[w, 0].set(st["y"], mode="drop")
-        return out
-
-    def finish(out, lane, st, fin):
-        w = jnp.where(fin & (lane < L), lane, L)
-        first_t, first_kind, min_N, max_tilt = _lane_monitor(st)
-        for key, val in (
-            ("y_final", st["y"]),
-            ("status", _lane_status(st)),
-            ("num_steps", st["num_steps"]),
-            ("first_invalid_t", first_t),
-            ("first_invalid_kind", first_kind.astype(jnp.int32)),
-            ("min_N", min_N),
-            ("max_tilt", max_tilt),
-        ):
-            out[key] = out[key].at[w].set(val, mode="drop")
-        return out
-
-    lane = jnp.arange(B, dtype=jnp.int32)
-    slots = init_v(*take(lane))
+    lane = lane_at(jnp.arange(B, dtype=jnp.int32))
+    slots = take(lane, ls)
+    no = jnp.asarray(-jnp.inf)
 
     def body(c):
-        slots, lane, nxt, out, iters, slot_steps = c
-        out = write_initial(out, lane, slots)
-        slots = dict(slots, at_t0=jnp.zeros_like(slots["at_t0"]))
+        slots, lane, nxt, wait, ls, samples, iters, slot_steps = c
         active = (lane < L) & ~slots["done"]
-        stepped, hit = step_v(slots)
+        stepped, hit, paused = step_v(slots)
         slots = jax.tree_util.tree_map(
             lambda a, b: jnp.where(jnp.reshape(active, active.shape + (1,) * (a.ndim - 1)), a, b), stepped, slots
         )
         w = jnp.where(active & hit, lane, L)
-        out["samples"] = out["samples"].at[w, slots["k"] - 1].set(slots["y"], mode="drop")
-        fin = (lane < L) & slots["done"]
-        out = finish(out, lane, slots, fin)
-        rank = jnp.cumsum(fin.astype(jnp.int32)) - 1
-        cand = nxt + rank
-        refill = fin & (cand < L)
-        lane = jnp.where(fin, jnp.where(refill, cand, L), lane).astype(jnp.int32)
-        nxt = nxt + jnp.sum(refill).astype(jnp.int32)
+        samples = samples.at[w, slots["k"] - 1].set(slots["y"], mode="drop")
+        pause = active & paused
+        fin = (lane < L) & (slots["done"] | pause)
 
-        def do_refill(slots):
-            # a lane that is done at its start (invalid initial state with stop_on_invalid)
-            # finishes in the next iteration without stepping
-            fresh = init_v(*take(lane))
-            return jax.tree_util.tree_map(
+        def swap(args):
+            # Write finished and paused lanes back; a paused lane waits with its predicted
+            # remaining cost (steps so far x remaining / elapsed time span) as priority.
+            # Free slots take the queue's next lanes, then the waiting lanes, costliest first.
+            slots, lane, nxt, wait, ls = args
+            wb = jnp.where(fin, lane, L)
+            slots = dict(slots, resumed=slots["resumed"] | pause)
+            ls = jax.tree_util.tree_map(lambda a, s: a.at[wb].set(s, mode="drop"), ls, {k: slots[k] for k in ls})
+            elapsed = slots["tprev"] - t0
+            cost = slots["num_steps"] * (slots["t1"] - slots["tprev"]) / jnp.where(elapsed > 0, elapsed, 1.0)
+            wait = wait.at[jnp.where(pause, lane, L)].set(cost.astype(wait.dtype), mode="drop")
+            rank = jnp.cumsum(fin.astype(jnp.int32)) - 1
+            from_queue = nxt + rank < n_queue
+            by_cost = jnp.argsort(-wait)  # waiting lanes first (the others wait at -inf)
+            pick = by_cost[jnp.clip(rank - jnp.maximum(n_queue - nxt, 0), 0, L - 1)]
+            new_lane = jnp.where(from_queue, lane_at(nxt + rank), jnp.where(wait[pick] > no, pick, L))
+            new_lane = jnp.where(fin, new_lane, lane).astype(jnp.int32)
+            refill = fin & (new_lane < L)
+            wait = wait.at[jnp.where(refill & ~from_queue, new_lane, L)].set(no, mode="drop")
+            nxt = nxt + jnp.sum(refill & from_queue).astype(jnp.int32)
+            fresh = take(new_lane, ls)
+            slots = jax.tree_util.tree_map(
                 lambda a, b: jnp.where(jnp.reshape(refill, refill.shape + (1,) * (a.ndim - 1)), a, b), fresh, slots
             )
+            return slots, jnp.where(fin, jnp.where(refill, new_lane, L), lane).astype(jnp.int32), nxt, wait, ls
 
-        slots = jax.lax.cond(jnp.any(refill), do_refill, lambda s: s, slots)
-        return slots, lane, nxt, out, iters + 1, slot_steps + lane.shape[0]
+        slots, lane, nxt, wait, ls = jax.lax.cond(jnp.any(fin), swap, lambda a: a, (slots, lane, nxt, wait, ls))
+        return slots, lane, nxt, wait, ls, samples, iters + 1, slot_steps + lane.shape[0]
 
     # The drain: once no more than half of the slots have work left (running lanes plus lanes
     # not yet started), the running lanes are gathered into a pool half as wide and go on
@@ -680,11 +703,12 @@ def _pool(
     while L > B and widths[-1] // 2 >= MIN_DRAIN_WIDTH:
         widths.append(widths[-1] // 2)
     z = jnp.zeros((), jnp.int32)
-    carry = (slots, lane, jnp.asarray(B, jnp.int32), out, z, z)
+    wait = jnp.full((L,), -jnp.inf)  # paused lanes: their predicted remaining cost
+    carry = (slots, lane, jnp.minimum(jnp.asarray(B, jnp.int32), n_queue), wait, ls, samples, z, z)
     for nxt_w in [*widths[1:], 0]:
 
         def cond(c, nxt_w=nxt_w):
-            work = jnp.sum(c[1] < L) + jnp.maximum(L - c[2], 0)
+            work = jnp.sum(c[1] < L) + jnp.maximum(n_queue - c[2], 0) + jnp.sum(c[3] > -jnp.inf)
             return jnp.any(c[1] < L) & (work > nxt_w)
 
         carry = jax.lax.while_loop(cond, body, carry)
@@ -692,12 +716,22 @@ def _pool(
             slots, lane = carry[0], carry[1]
             keep = jnp.argsort(lane >= L, stable=True)[:nxt_w]  # the running lanes first
             carry = (jax.tree_util.tree_map(lambda x, keep=keep: x[keep], slots), lane[keep], *carry[2:])
-    _, _, _, out, iters, slot_steps = carry
-    out["t_samples"] = ts_all
-    out["pool_iterations"] = jnp.full((L,), iters)
-    out["pool_slot_steps"] = jnp.full((L,), slot_steps)  # step slots paid, over all widths
-    out["pool_width"] = jnp.full((L,), B)
-    return out
+    _, _, _, _, ls, samples, iters, slot_steps = carry
+    return ls, samples, iters, slot_steps
+
+
+def _lane_outputs(ls: dict[str, Array]) -> dict[str, Array]:
+    """Per-lane results from the final lane states."""
+    first_t, first_kind, min_N, max_tilt = jax.vmap(_lane_monitor)(ls)
+    return dict(
+        y_final=ls["y"],
+        status=jax.vmap(_lane_status)(ls),
+        num_steps=ls["num_steps"],
+        first_invalid_t=first_t,
+        first_invalid_kind=first_kind.astype(jnp.int32),
+        min_N=min_N,
+        max_tilt=max_tilt,
+    )
 
 
 def _lyap_lane(p: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig) -> Array:
@@ -723,24 +757,52 @@ def _sharded(run: Callable, mesh: Any, n_in: int) -> Callable:
 
 
 @eqx.filter_jit
-def _pool_chunk(
+def _init_chunk(
     pb: CeltParams,
     y0b: Array,
     live: Array,
     transient: Array,
     tols: Array,
     cfg: SweepConfig,
+    mesh: Any,
+    vary: tuple[bool, ...],
+) -> tuple[dict[str, Array], Array]:
+    return _sharded(lambda pb, y0b, live: _init_lanes(pb, y0b, live, transient, tols, cfg, vary), mesh, 3)(pb, y0b, live)
+
+
+@eqx.filter_jit
+def _pool_chunk(
+    pb: CeltParams,
+    ls: dict[str, Array],
+    samples: Array,
+    queue: Array,
+    n_queue: Array,
+    pause_frac: Array,
+    transient: Array,
+    cfg: SweepConfig,
     width: int,
     mesh: Any,
     vary: tuple[bool, ...],
     opaque_true: Array,
-) -> dict[str, Array]:
-    def run(pb, y0b, live):
-        out = _pool(pb, y0b, live, transient, tols, cfg, width, vary, opaque_true)
-        out.update(jax.vmap(_extras)(out["samples"], pb))
-        return out
+) -> tuple[dict[str, Array], Array, Array, Array]:
+    def run(pb, ls, samples, queue, n_queue):
+        ls, samples, iters, slot_steps = _pool(
+            pb, ls, samples, queue, n_queue[0], pause_frac, transient, cfg, width, vary, opaque_true
+        )
+        return ls, samples, iters[None], slot_steps[None]  # loop counters: one per device
 
-    return _sharded(run, mesh, 3)(pb, y0b, live)
+    return _sharded(run, mesh, 5)(pb, ls, samples, queue, n_queue)
+
+
+@eqx.filter_jit
+def _finish_chunk(
+    pb: CeltParams, ls: dict[str, Array], samples: Array, transient: Array, cfg: SweepConfig, mesh: Any
+) -> dict[str, Array]:
+    def run(pb, ls, samples):
+        out = dict(_lane_outputs(ls), samples=samples, t_samples=_section_times(pb, transient, cfg))
+        return dict(out, **jax.vmap(_extras)(samples, pb))
+
+    return _sharded(run, mesh, 3)(pb, ls, samples)
 
 
 @eqx.filter_jit
@@ -763,9 +825,13 @@ def _pad(x: np.ndarray, n: int) -> np.ndarray:
 
 
 SCHEDULERS = ("pool", "chunks")
-DEFAULT_WIDTH = 64
+DEFAULT_WIDTH = 96
+"""pool slots per device. Each pool iteration pays a fixed cost (~330 XLA kernel launches,
+~30 us on CPU) besides its per-slot work, so wider pools finish in fewer iterations; 96 was
+fastest for 400 lanes on 2 cores (``benchmarks/bench_pool_width.py``)."""
 MIN_DRAIN_WIDTH = 16  # narrowest pool of the drain (narrower costs more per slot than it saves)
-"""pool slots per device (``benchmarks/bench_pool_width.py``: 64 was fastest for 400 lanes on 2 cores)"""
+PILOT_FRACTION = 0.1
+"""the first deal runs every lane over this fraction of its time span (see `run_lanes`)"""
 
 
 def run_lanes(
@@ -779,13 +845,16 @@ def run_lanes(
     width: int | None = None,
     compile_only: bool = False,
     varying: Sequence[str] = (),
+    pilot_fraction: float = PILOT_FRACTION,
 ) -> dict[str, np.ndarray]:
     """Run one chunk of lanes (batched params and y0 with a leading lane axis) and return numpy arrays.
 
     ``scheduler="pool"`` (default): ``width`` batch slots per device (default
     `DEFAULT_WIDTH`) step in one jitted while loop; a slot whose lane finishes is refilled
     with the next lane at once, so no slot idles until the slowest lane is done (only the
-    final drain does). The Lyapunov stage (``cfg.lyapunov_periods > 0``) then runs vmapped
+    final drain does). ``pilot_fraction`` (default `PILOT_FRACTION`; 0 = off; only used
+    when a device has more lanes than slots): each lane pauses once after this fraction of
+    its time span and is taken up again costliest-predicted first (see `_pool`). The Lyapunov stage (``cfg.lyapunov_periods > 0``) then runs vmapped
     over the successful lanes in groups of ``width`` ordered by the measured main-solve
     step count (a cost estimate that needs no pilot run).
     ``scheduler="chunks"``: the whole chunk is one vmapped `simulate` (every slot runs until
@@ -817,31 +886,44 @@ def run_lanes(
     W = int(width or DEFAULT_WIDTH)
     if W < 1:
         raise ValueError(f"width must be >= 1, got {width!r}")
-    # device d gets lanes d, d + ndev, ... (a mix of cheap and expensive lanes per device)
-    perm = np.arange(Lp).reshape(-1, ndev).T.reshape(-1)
-    live = (np.arange(Lp)[perm] < L) & (not compile_only)
     nocfg = dataclasses.replace(static_cfg, lyapunov_periods=0)
     unknown = set(varying) - set(PARAM_NAMES)
     if unknown:
         raise ValueError(f"varying: unknown parameter name(s) {sorted(unknown)}")
     path_leaves = jax.tree_util.tree_flatten_with_path(pb_np)[0]
     vary = tuple(bool(path[-1].name in varying or np.any(x != x[:1])) for path, x in path_leaves)
-    out = _pool_chunk(
-        jax.tree_util.tree_map(lambda x: x[perm], pb_np),
-        y0_np[perm],
-        live,
-        transient,
-        jnp.asarray([cfg.rtol, cfg.atol]),
-        nocfg,
-        min(W, Lp // ndev),
-        mesh,
-        vary,
-        jnp.asarray(True),
+    Lloc = Lp // ndev
+    Wd = min(W, Lloc)
+    # position i of the sharded arrays holds lane pos_lane[i]; device d holds positions
+    # d Lloc ... (d + 1) Lloc - 1 and gets lanes d, d + ndev, ... (a mix of cheap and costly)
+    pos_lane = np.arange(Lp).reshape(-1, ndev).T.reshape(-1)
+    pb_p = jax.tree_util.tree_map(lambda x: x[pos_lane], pb_np)
+    live = (pos_lane < L) & (not compile_only)
+    tols = jnp.asarray([cfg.rtol, cfg.atol])
+    ls, samples = _init_chunk(pb_p, y0_np[pos_lane], live, transient, tols, nocfg, mesh, vary)
+    # per device: the local positions of its lanes that have work, in order (lanes invalid at
+    # t0 with stop_on_invalid, and padding, are done at the start)
+    pending = np.flatnonzero(~np.asarray(ls["done"]))
+    queue = np.full(Lp, Lloc, np.int32)
+    n_queue = np.zeros(ndev, np.int32)
+    for d in range(ndev):
+        mine = pending[(pending >= d * Lloc) & (pending < (d + 1) * Lloc)] - d * Lloc
+        queue[d * Lloc : d * Lloc + len(mine)] = mine
+        n_queue[d] = len(mine)
+    # the pilot pause only pays where lanes queue for slots
+    frac = float(pilot_fraction) if pilot_fraction and Lloc > Wd else np.inf
+    ls, samples, iters, slot_steps = _pool_chunk(
+        pb_p, ls, samples, queue, n_queue, jnp.asarray(frac), transient, nocfg, Wd, mesh, vary, jnp.asarray(True)
     )
+    iters, slot_steps = np.asarray(iters), int(np.sum(np.asarray(slot_steps)))
+    out = _finish_chunk(pb_p, ls, samples, transient, nocfg, mesh)
     out = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(out))
-    inv = np.empty_like(perm)
-    inv[perm] = np.arange(Lp)
+    inv = np.empty_like(pos_lane)
+    inv[pos_lane] = np.arange(Lp)
     out = {k: v[inv][:L] for k, v in out.items()}
+    out["pool_iterations"] = np.full(L, int(iters.max()))  # the busiest device's loop iterations
+    out["pool_slot_steps"] = np.full(L, slot_steps)  # step slots paid, all devices, widths, deals
+    out["pool_width"] = np.full(L, Wd)
     out["valid"] = out["first_invalid_kind"] == 0
     out["lyapunov"] = np.full(L, np.nan)
     if cfg.lyapunov_periods > 0 and not compile_only:
