@@ -601,8 +601,6 @@ def _pool(
     pb: CeltParams,
     ls: dict[str, Array],
     samples: Array,
-    queue: Array,
-    n_queue: Array,
     pause_frac: Array,
     transient: Array,
     cfg: SweepConfig,
@@ -610,10 +608,11 @@ def _pool(
     vary: tuple[bool, ...],
     opaque_true: Array,
 ) -> tuple[dict[str, Array], Array, Array, Array]:
-    """Lanes ``queue[:n_queue]`` through ``width`` slots (refilled as lanes finish).
+    """The lanes of ``ls`` that are not done yet, in order, through ``width`` slots (refilled
+    as lanes finish).
 
-    ``ls``: every lane's state (`_init_lanes`, or a previous pool's output); a lane is taken
-    from it when a slot is free and written back when it is done or paused. A lane pauses at
+    ``ls``: every lane's state (`_init_lanes`); a lane is taken from it when a slot is free
+    and written back when it is done or paused. A lane pauses at
     the end of its first step past t0 + ``pause_frac`` (t1 - t0) (inf: never): it stops
     between two steps, so resuming it from ``ls`` continues the very same step sequence.
     ``samples`` (L, S, 13): the section buffer, written in place. ``vary``: see
@@ -624,6 +623,9 @@ def _pool(
     pv_all, params_of = _param_split(pb, vary)
     L = samples.shape[0]
     B = min(width, L)
+    # the queue: lanes with work (not padding, not invalid at t0 with stop_on_invalid), in order
+    queue = jnp.argsort(ls["done"], stable=True).astype(jnp.int32)
+    n_queue = jnp.sum(~ls["done"]).astype(jnp.int32)
     ts_all = _section_times(pb, transient, cfg)
     t0 = jnp.asarray(cfg.t0, jnp.float64)
     tab = _erk_tableau(cfg)
@@ -757,52 +759,27 @@ def _sharded(run: Callable, mesh: Any, n_in: int) -> Callable:
 
 
 @eqx.filter_jit
-def _init_chunk(
+def _pool_chunk(
     pb: CeltParams,
     y0b: Array,
     live: Array,
-    transient: Array,
-    tols: Array,
-    cfg: SweepConfig,
-    mesh: Any,
-    vary: tuple[bool, ...],
-) -> tuple[dict[str, Array], Array]:
-    return _sharded(lambda pb, y0b, live: _init_lanes(pb, y0b, live, transient, tols, cfg, vary), mesh, 3)(pb, y0b, live)
-
-
-@eqx.filter_jit
-def _pool_chunk(
-    pb: CeltParams,
-    ls: dict[str, Array],
-    samples: Array,
-    queue: Array,
-    n_queue: Array,
     pause_frac: Array,
     transient: Array,
+    tols: Array,
     cfg: SweepConfig,
     width: int,
     mesh: Any,
     vary: tuple[bool, ...],
     opaque_true: Array,
-) -> tuple[dict[str, Array], Array, Array, Array]:
-    def run(pb, ls, samples, queue, n_queue):
-        ls, samples, iters, slot_steps = _pool(
-            pb, ls, samples, queue, n_queue[0], pause_frac, transient, cfg, width, vary, opaque_true
-        )
-        return ls, samples, iters[None], slot_steps[None]  # loop counters: one per device
-
-    return _sharded(run, mesh, 5)(pb, ls, samples, queue, n_queue)
-
-
-@eqx.filter_jit
-def _finish_chunk(
-    pb: CeltParams, ls: dict[str, Array], samples: Array, transient: Array, cfg: SweepConfig, mesh: Any
-) -> dict[str, Array]:
-    def run(pb, ls, samples):
+) -> tuple[dict[str, Array], Array, Array]:
+    def run(pb, y0b, live):
+        ls, samples = _init_lanes(pb, y0b, live, transient, tols, cfg, vary)
+        ls, samples, iters, slot_steps = _pool(pb, ls, samples, pause_frac, transient, cfg, width, vary, opaque_true)
         out = dict(_lane_outputs(ls), samples=samples, t_samples=_section_times(pb, transient, cfg))
-        return dict(out, **jax.vmap(_extras)(samples, pb))
+        out.update(jax.vmap(_extras)(samples, pb))
+        return out, iters[None], slot_steps[None]  # loop counters: one per device
 
-    return _sharded(run, mesh, 3)(pb, ls, samples)
+    return _sharded(run, mesh, 3)(pb, y0b, live)
 
 
 @eqx.filter_jit
@@ -827,11 +804,13 @@ def _pad(x: np.ndarray, n: int) -> np.ndarray:
 SCHEDULERS = ("pool", "chunks")
 DEFAULT_WIDTH = 96
 """pool slots per device. Each pool iteration pays a fixed cost (~330 XLA kernel launches,
-~30 us on CPU) besides its per-slot work, so wider pools finish in fewer iterations; 96 was
-fastest for 400 lanes on 2 cores (``benchmarks/bench_pool_width.py``)."""
+~30 us on CPU) besides its per-slot work, so wider pools finish in fewer iterations; with the
+pilot pause, 96 was fastest for 400 lanes x 300 periods on 2 cores
+(``benchmarks/bench_schedule.py``; docs/bifurcation/README.md)."""
 MIN_DRAIN_WIDTH = 16  # narrowest pool of the drain (narrower costs more per slot than it saves)
 PILOT_FRACTION = 0.1
-"""the first deal runs every lane over this fraction of its time span (see `run_lanes`)"""
+"""a lane pauses once after this fraction of its time span and waits for a slot with its
+predicted remaining cost (see `_pool`; ``benchmarks/bench_schedule.py``)"""
 
 
 def run_lanes(
@@ -900,29 +879,18 @@ def run_lanes(
     pb_p = jax.tree_util.tree_map(lambda x: x[pos_lane], pb_np)
     live = (pos_lane < L) & (not compile_only)
     tols = jnp.asarray([cfg.rtol, cfg.atol])
-    ls, samples = _init_chunk(pb_p, y0_np[pos_lane], live, transient, tols, nocfg, mesh, vary)
-    # per device: the local positions of its lanes that have work, in order (lanes invalid at
-    # t0 with stop_on_invalid, and padding, are done at the start)
-    pending = np.flatnonzero(~np.asarray(ls["done"]))
-    queue = np.full(Lp, Lloc, np.int32)
-    n_queue = np.zeros(ndev, np.int32)
-    for d in range(ndev):
-        mine = pending[(pending >= d * Lloc) & (pending < (d + 1) * Lloc)] - d * Lloc
-        queue[d * Lloc : d * Lloc + len(mine)] = mine
-        n_queue[d] = len(mine)
     # the pilot pause only pays where lanes queue for slots
     frac = float(pilot_fraction) if pilot_fraction and Lloc > Wd else np.inf
-    ls, samples, iters, slot_steps = _pool_chunk(
-        pb_p, ls, samples, queue, n_queue, jnp.asarray(frac), transient, nocfg, Wd, mesh, vary, jnp.asarray(True)
+    out, iters, slot_steps = _pool_chunk(
+        pb_p, y0_np[pos_lane], live, jnp.asarray(frac), transient, tols, nocfg, Wd, mesh, vary, jnp.asarray(True)
     )
     iters, slot_steps = np.asarray(iters), int(np.sum(np.asarray(slot_steps)))
-    out = _finish_chunk(pb_p, ls, samples, transient, nocfg, mesh)
     out = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(out))
     inv = np.empty_like(pos_lane)
     inv[pos_lane] = np.arange(Lp)
     out = {k: v[inv][:L] for k, v in out.items()}
     out["pool_iterations"] = np.full(L, int(iters.max()))  # the busiest device's loop iterations
-    out["pool_slot_steps"] = np.full(L, slot_steps)  # step slots paid, all devices, widths, deals
+    out["pool_slot_steps"] = np.full(L, slot_steps)  # step slots paid, over all devices and widths
     out["pool_width"] = np.full(L, Wd)
     out["valid"] = out["first_invalid_kind"] == 0
     out["lyapunov"] = np.full(L, np.nan)
