@@ -24,12 +24,18 @@ Execution model
   slightly (a few steps in ~400, samples ~1e-9 apart at rtol 1e-7). Lane order (and hence
   slot assignment) is fixed and the per-lane arithmetic does not depend on the slot, so
   results are deterministic and a lane's result does not depend on its neighbours (a lane
-  that hits ``max_steps`` is flagged and the others are bitwise unchanged).
+  that hits ``max_steps`` is flagged and the others are unchanged: same steps and status,
+  samples to rounding). What is guaranteed, and tested: a lane gives the same step count and
+  status and samples equal to ~1e-10 over a few periods whatever the pool width, device count,
+  schedule or neighbours; bitwise only when the *same* compiled program runs again on the same
+  machine (a resumed sweep). Two different compiled programs (another width, device count, or a
+  CPU with another vector ISA, AVX2 vs AVX-512) may round differently, and over hundreds of
+  periods chaotic lanes then diverge from that seed like any other perturbation.
   When lanes queue for slots, every lane first runs a tenth of its time span
   (`PILOT_FRACTION`) and pauses between two steps; paused lanes wait with their predicted
   remaining cost (steps so far x remaining / elapsed span) and free slots take them costliest
   first (longest-processing-time order), so the drain runs on short lanes. A pause does not
-  change a lane: it resumes with the same state and step sequence (tested bitwise).
+  change a lane: it resumes with the same state and step sequence (tested to rounding).
   ``sort_by_cost=True`` orders lanes by the cost proxy 1/omega_pi (time span of a period),
   longest first. The optional Lyapunov stage then runs
   vmapped over the successful lanes in groups of ``width`` ordered by the measured
@@ -699,7 +705,7 @@ def _pool(
     # not yet started), the running lanes are gathered into a pool half as wide and go on
     # there (widths B, B/2, B/4, ... down to 16), so that the end of a chunk does not pay for
     # idle slots at the full width's cost. Per-lane results do not depend on the width
-    # (vectorised widths >= 4 give bitwise equal lanes; tested). Each width compiles the step
+    # (same steps and statuses, samples to rounding; tested). Each width compiles the step
     # again (~9 s on CPU), so only pools with a queue (more lanes than slots) do this.
     widths = [B]
     while L > B and widths[-1] // 2 >= MIN_DRAIN_WIDTH:

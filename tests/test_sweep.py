@@ -10,7 +10,7 @@ import textwrap
 import jax
 import numpy as np
 import pytest
-from _sweep_common import KW, VALUES
+from _sweep_common import KW, SAMPLE_ATOL, VALUES, assert_same_lanes
 
 import jaxcelt as jc
 from jaxcelt.sweep import bifurcation, continuation, lanes_params, parse_range
@@ -57,7 +57,8 @@ def test_sweep_equals_single_simulate(base, paper_params):
 def test_failing_lane_is_isolated(base, paper_params):
     # A lane made stiff (mu = 30: the sticking relaxation rate ~ mu g/(a_hat sqrt(eps)),
     # MODEL.md section 10, grows 130x) exhausts max_steps; it is flagged and the other lanes
-    # are bitwise unchanged.
+    # are unchanged: same step counts, samples within SAMPLE_ATOL (a varying mu compiles
+    # another program than the base sweep, so rounding may differ; see _sweep_common).
     y0 = np.asarray(jc.initial_state(paper_params))
     params = paper_params
     from jaxcelt.sweep import SweepConfig, run_lanes
@@ -71,8 +72,9 @@ def test_failing_lane_is_isolated(base, paper_params):
     assert out["status"][2] == 1  # max_steps reached
     assert np.all(out["status"][[0, 1, 3]] == 0)
     for i in (0, 1, 3):
-        assert np.array_equal(out["samples"][i], base.samples[i])  # bitwise
         assert out["num_steps"][i] == base.num_steps[i]
+        assert np.isfinite(out["samples"][i]).all()
+        np.testing.assert_allclose(out["samples"][i], base.samples[i], rtol=0, atol=SAMPLE_ATOL)
 
 
 def test_multistart_shapes(paper_params):
@@ -157,7 +159,9 @@ def test_stop_on_invalid_lanes_equal_simulate(base, paper_params):
         np.testing.assert_allclose(float(sol.validity.first_invalid_t), r.first_invalid_t[i], rtol=1e-9)
     assert np.isinf(r.samples[0, -1]).all()  # stopped before the last section
     assert r.num_steps[0] < base.num_steps[0]
-    np.testing.assert_array_equal(r.samples[1:], base.samples[1:])
+    # valid lanes: stop_on_invalid compiles another program; same lanes within SAMPLE_ATOL
+    np.testing.assert_allclose(r.samples[1:], base.samples[1:], rtol=0, atol=SAMPLE_ATOL)
+    np.testing.assert_array_equal(r.num_steps[1:], base.num_steps[1:])
 
 
 @pytest.mark.slow
@@ -204,10 +208,12 @@ def test_pool_other_solvers_equal_simulate(paper_params, solver):
             assert err <= 1e-10, err
 
 
-def test_pool_drain_compaction_keeps_lanes_bitwise(paper_params):
+def test_pool_drain_compaction_keeps_lanes(paper_params):
     # 40 lanes through 32 slots: once <= 16 lanes are left the pool continues 16 wide
     # (`_pool`'s drain). Lanes must not depend on the width they ran at: compare with a
-    # pool that is 8 wide from the start (bitwise; vectorised widths give identical lanes).
+    # pool that is 8 wide from the start. Different widths are different compiled programs
+    # (on an AVX-512 CPU ~half the samples differ at <= 1.6e-12 relative), so: same step
+    # counts and statuses, samples within SAMPLE_ATOL (see _sweep_common).
     from jaxcelt.sweep import SweepConfig, run_lanes
 
     vals = np.linspace(12.0, 19.0, 40)
@@ -220,16 +226,16 @@ def test_pool_drain_compaction_keeps_lanes_bitwise(paper_params):
     it, paid = int(wide["pool_iterations"][0]), int(wide["pool_slot_steps"][0])
     assert paid < 32 * it  # the drain ran narrower
     assert paid >= int(wide["num_steps"].sum())
-    np.testing.assert_array_equal(wide["num_steps"], narrow["num_steps"])
-    np.testing.assert_array_equal(wide["samples"], narrow["samples"])
-    np.testing.assert_array_equal(wide["status"], narrow["status"])
+    assert_same_lanes(wide, narrow)
 
 
-def test_pool_pilot_pause_keeps_lanes_bitwise(paper_params):
+def test_pool_pilot_pause_keeps_lanes(paper_params):
     # With more lanes than slots every lane first pauses after a tenth of its time span and
     # waits; free slots then take the waiting lanes costliest first (`_pool`). A pause falls
-    # between two steps, so each lane must equal a run without pauses bitwise -- including
-    # lanes that run out of steps (max_steps: status 1) and lanes that stop invalid.
+    # between two steps, so each lane must equal a run without pauses -- including lanes that
+    # run out of steps (max_steps: status 1) and lanes that stop invalid. The pilot is another
+    # compiled program, so: same steps and statuses, floats within SAMPLE_ATOL (min_N to rtol
+    # 1e-7: N is a stiff function of the state, see test_sweep_equals_single_simulate).
     from jaxcelt.sweep import SweepConfig, run_lanes
 
     vals = np.linspace(10.0, 19.0, 40)
@@ -242,5 +248,6 @@ def test_pool_pilot_pause_keeps_lanes_bitwise(paper_params):
     assert set(np.unique(plain["status"])) >= {0, 1}  # the case covers finished and failed lanes
     # the schedules differ (the pilot reorders the lanes), the lanes do not
     assert int(pilot["pool_slot_steps"][0]) != int(plain["pool_slot_steps"][0])
-    for key in ("samples", "num_steps", "status", "y_final", "first_invalid_t", "min_N", "max_tilt"):
-        np.testing.assert_array_equal(pilot[key], plain[key], err_msg=key)
+    assert_same_lanes(pilot, plain, keys=("samples", "num_steps", "status", "y_final", "max_tilt"))
+    np.testing.assert_allclose(pilot["first_invalid_t"], plain["first_invalid_t"], rtol=1e-9)
+    np.testing.assert_allclose(pilot["min_N"], plain["min_N"], rtol=1e-7)
