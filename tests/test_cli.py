@@ -6,6 +6,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from jaxcelt.cli import main
 from jaxcelt.io import load_trajectory
@@ -25,9 +26,75 @@ def test_simulate_writes_data_and_figure(tmp_path):
 
 
 def test_simulate_rejects_bad_parameter(tmp_path, capsys):
-    rc = main(["simulate", "--set", "m=-1", "--out", str(tmp_path)])
-    assert rc == 2
-    assert "'m'" in capsys.readouterr().out
+    with pytest.raises(SystemExit) as e:
+        main(["simulate", "--set", "m=-1", "--out", str(tmp_path)])
+    assert e.value.code == 2
+    assert "'m'" in capsys.readouterr().err
+    assert not tmp_path.joinpath("celt_w17.npz").exists()
+
+
+# Bad input in every command: one line "jaxcelt <command>: error: <message naming the parameter>"
+# on stderr, exit status 2, nothing on stdout, no traceback; checked before any integration runs.
+BAD_INPUT = [
+    (["bifurcation", "--set", "mu=-1"], "'mu'"),
+    (["bifurcation", "--set", "nonsense=3"], "nonsense"),
+    (["bifurcation", "--set", "mu"], "--set"),
+    (["bifurcation", "--omega", "14:15:abc"], "--omega"),
+    (["bifurcation", "--omega", "14:15"], "--omega"),
+    (["bifurcation", "--omega", "14:15:0"], "--omega"),
+    (["bifurcation", "--transient", "-3"], "--transient"),
+    (["bifurcation", "--sample", "0"], "--sample"),
+    (["bifurcation", "--lyapunov", "x"], "--lyapunov"),
+    (["bifurcation", "--rtol", "-1"], "--rtol"),
+    (["bifurcation", "--omega0", "1,2"], "--omega0"),
+    (["bifurcation", "--host-devices", "0"], "--host-devices"),
+    (["bifurcation", "--param", "nonsense", "--values", "1,2"], "--param"),
+    (["bifurcation", "--param", "mu"], "--values"),
+    (["bifurcation", "--param", "mu", "--values", "0.1,-0.2"], "'mu'"),
+    (["simulate", "--set", "m=-1"], "'m'"),
+    (["simulate", "--periods", "0"], "--periods"),
+    (["simulate", "--omega-pi", "nan"], "--omega-pi"),
+    (["simulate", "--n0", "0,0"], "--n0"),
+    (["ladder", "--scene", "nonsense"], "--scene"),
+    (["ladder", "--laws", "pade,nonsense"], "--laws"),
+    (["ladder", "--tol", "-1"], "--tol"),
+    (["fit", "missing.npz", "--set", "mu=-1"], "'mu'"),
+    (["fit", "missing.npz", "--max-iter", "0"], "--max-iter"),
+    (["fit", "missing.npz"], "missing.npz"),
+]
+
+
+@pytest.mark.parametrize("argv,named", BAD_INPUT, ids=[" ".join(a) for a, _ in BAD_INPUT])
+def test_bad_input_is_one_error_line(argv, named, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # outputs (if any were written) land here; "missing.npz" does not exist
+    monkeypatch.delenv("JAXCELT_TRACEBACK", raising=False)
+    monkeypatch.setenv("JAXCELT_CACHE_DIR", "off")
+    with pytest.raises(SystemExit) as e:
+        main(argv)
+    assert e.value.code == 2
+    out, err = capsys.readouterr()
+    lines = err.splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith(f"jaxcelt {argv[0]}: error: "), lines[0]
+    assert named in lines[0]
+    assert "Traceback" not in err and out == ""
+    assert not any(tmp_path.iterdir())  # rejected before anything was written
+
+
+def test_bad_input_traceback_on_request(monkeypatch):
+    # JAXCELT_TRACEBACK=1: the ValueError itself (for debugging), not the one-line report
+    monkeypatch.setenv("JAXCELT_TRACEBACK", "1")
+    monkeypatch.setenv("JAXCELT_CACHE_DIR", "off")
+    with pytest.raises(ValueError, match="'mu'"):
+        main(["bifurcation", "--set", "mu=-1"])
+
+
+def test_bad_input_from_the_shell():
+    # the installed entry point (python -m jaxcelt): exit status 2 and one stderr line
+    cmd = [sys.executable, "-m", "jaxcelt", "bifurcation", "--set", "mu=-1"]
+    r = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ, JAXCELT_CACHE_DIR="off"))
+    assert r.returncode == 2
+    assert r.stderr.splitlines() == ["jaxcelt bifurcation: error: parameter 'mu' must be >= 0, got -1.0"]
 
 
 def test_import_does_not_start_the_jax_backend():
@@ -77,8 +144,6 @@ def test_bifurcation_solver_option(tmp_path):
 
 
 def test_bifurcation_rejects_unknown_solver(capsys):
-    import pytest
-
     with pytest.raises(SystemExit) as e:
         main(["bifurcation", "--solver", "RK45"])
     assert e.value.code == 2

@@ -12,6 +12,8 @@ import json
 import time
 from pathlib import Path
 
+from .args import UsageError, floats, nonnegative_int, override, overrides, positive_float, positive_int, value_range
+
 SWEEP_SOLVERS = ("Tsit5", "Dopri5", "Dopri8")  # names in jaxcelt.benchmarking.SOLVERS
 
 
@@ -22,20 +24,33 @@ def register(sub) -> None:
         description=__doc__.splitlines()[0],
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
-    p.add_argument("--omega", default="10:20:60", help="omega_pi values [rad/s]: START:STOP:COUNT or a,b,c")
+    p.add_argument(
+        "--omega", type=value_range, default="10:20:60", help="omega_pi values [rad/s]: START:STOP:COUNT or a,b,c"
+    )
     p.add_argument("--param", default="omega_pi", help="swept CeltParams field (values from --values)")
     p.add_argument(
-        "--values", default=None, help="values of --param when it is not omega_pi (START:STOP:COUNT or list)"
+        "--values",
+        type=value_range,
+        default=None,
+        help="values of --param when it is not omega_pi (START:STOP:COUNT or list)",
     )
-    p.add_argument("--transient", type=int, default=100, help="transient forcing periods discarded")
-    p.add_argument("--sample", type=int, default=30, help="stroboscopic samples (periods) kept")
+    p.add_argument("--transient", type=nonnegative_int, default=100, help="transient forcing periods discarded")
+    p.add_argument("--sample", type=positive_int, default=30, help="stroboscopic samples (periods) kept")
     p.add_argument(
-        "--lyapunov", type=int, default=30, help="periods of tangent dynamics for the Lyapunov exponent (0: off)"
+        "--lyapunov",
+        type=nonnegative_int,
+        default=30,
+        help="periods of tangent dynamics for the Lyapunov exponent (0: off)",
     )
     p.add_argument(
-        "--set", action="append", default=[], metavar="NAME=VALUE", help="override any CeltParams field, repeatable"
+        "--set",
+        action="append",
+        type=override,
+        default=[],
+        metavar="NAME=VALUE",
+        help="override any CeltParams field, repeatable",
     )
-    p.add_argument("--omega0", default="0,0,0", help="initial omega (body) [rad/s]")
+    p.add_argument("--omega0", type=floats(3), default="0,0,0", help="initial omega (body) [rad/s]")
     p.add_argument(
         "--solver",
         default="Tsit5",
@@ -44,18 +59,18 @@ def register(sub) -> None:
         "8th-order Dormand-Prince family as scipy's DOP853: at rtol 1e-8 about 25x more accurate than Tsit5, "
         "as fast per sweep, but it compiles longer",
     )
-    p.add_argument("--rtol", type=float, default=1e-8)
-    p.add_argument("--atol", type=float, default=1e-10)
-    p.add_argument("--max-steps", type=int, default=1_000_000)
+    p.add_argument("--rtol", type=positive_float, default=1e-8)
+    p.add_argument("--atol", type=positive_float, default=1e-10)
+    p.add_argument("--max-steps", type=positive_int, default=1_000_000)
     p.add_argument(
         "--chunk-size",
-        type=int,
+        type=positive_int,
         default=200,
         help="lanes per jitted pool launch (the unit of resumable writing); split over the devices",
     )
     p.add_argument(
         "--width",
-        type=int,
+        type=positive_int,
         default=None,
         help="pool slots per device: lanes stepped side by side (vmap width; default jaxcelt.sweep.DEFAULT_WIDTH)",
     )
@@ -72,8 +87,13 @@ def register(sub) -> None:
         help="end a lane at its first invalid state (lift-off or n3 <= 0; the model does not hold past it): "
         "label 'invalid', later samples inf, no Lyapunov exponent. --no-stop-on-invalid integrates on",
     )
-    p.add_argument("--orbits", default="14,15.6,17,19", help="omega_pi values for phase-plot figures ('' for none)")
-    p.add_argument("--orbit-periods", type=int, default=40, help="periods shown in the phase plots")
+    p.add_argument(
+        "--orbits",
+        type=value_range,
+        default="14,15.6,17,19",
+        help="omega_pi values for phase-plot figures ('' for none)",
+    )
+    p.add_argument("--orbit-periods", type=positive_int, default=40, help="periods shown in the phase plots")
     p.add_argument("--out", type=Path, default=Path("out/bifurcation"), help="output directory (resumable)")
     p.add_argument("--no-figures", action="store_true")
     p.set_defaults(func=run)
@@ -111,9 +131,12 @@ def _set_host_devices(spec: str) -> int:
 
     import jax
 
-    n = (os.cpu_count() or 1) if spec == "auto" else int(spec)
+    try:
+        n = (os.cpu_count() or 1) if spec == "auto" else int(spec)
+    except ValueError:
+        n = 0
     if n < 1:
-        raise SystemExit(f"--host-devices must be >= 1 or 'auto', got {spec!r}")
+        raise UsageError(f"argument --host-devices: must be an integer >= 1 or 'auto', got {spec!r}")
     try:
         jax.config.update("jax_num_cpu_devices", n)
     except RuntimeError:  # backend already started (e.g. called from Python after JAX work)
@@ -128,17 +151,26 @@ def run(args) -> int:
 
     import jaxcelt as jc
     from jaxcelt.benchmarking import make_solver
-    from jaxcelt.commands.simulate import parse_overrides
     from jaxcelt.dataset import open_sweep
-    from jaxcelt.sweep import DEFAULT_WIDTH, orbit, parse_range, sweep
+    from jaxcelt.sweep import DEFAULT_WIDTH, orbit, sweep
     from jaxcelt.versions import versions_string
 
-    print(versions_string(), flush=True)
-    params = jc.CeltParams.paper(**parse_overrides(args.set))
-    values = parse_range(args.omega if args.param == "omega_pi" else (args.values or ""))
+    # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2), before any work
+    params = jc.CeltParams.paper(**overrides(args.set))
+    if args.param not in jc.PARAM_NAMES:
+        raise UsageError(f"argument --param: unknown parameter {args.param!r}; known: {', '.join(jc.PARAM_NAMES)}")
+    if args.param == "omega_pi":
+        values = args.omega
+    elif args.values is None:
+        raise UsageError(f"argument --values: required with --param {args.param}")
+    else:
+        values = args.values
     if values.size == 0:
-        raise SystemExit("no values to sweep (use --omega, or --values with --param)")
-    omega0 = [float(x) for x in args.omega0.split(",")]
+        raise UsageError("argument --omega/--values: no values to sweep")
+    for v in values:  # each lane's parameters must be valid too
+        params.replace(**{args.param: float(v)})
+    omega0 = args.omega0
+    print(versions_string(), flush=True)
     y0 = np.asarray(jc.initial_state(params, omega=omega0))
     args.out.mkdir(parents=True, exist_ok=True)
     solver = make_solver(args.solver)
@@ -201,8 +233,8 @@ def run(args) -> int:
         fig = bifurcation_figure(ds, color_by="lyapunov")
         fig.savefig(args.out / "bifurcation_lyapunov.png", dpi=150)
         plt.close(fig)
-    if args.param == "omega_pi" and args.orbits.strip():
-        for w in parse_range(args.orbits):
+    if args.param == "omega_pi" and args.orbits.size:
+        for w in args.orbits:
             pw = params.replace(omega_pi=float(w))
             o = orbit(
                 pw,
