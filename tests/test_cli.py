@@ -128,8 +128,15 @@ def test_bifurcation_solver_option(tmp_path):
     cmd = [sys.executable, "-m", "jaxcelt", "bifurcation", "--omega", "14,17", "--transient", "1", "--sample", "2",
            "--lyapunov", "0", "--orbits", "", "--solver", "Dopri5", "--host-devices", "1", "--no-figures",
            "--out", str(out)]  # fmt: skip
-    subprocess.run(cmd, check=True, capture_output=True, env=dict(os.environ, JAXCELT_CACHE_DIR="off"))
+    run = subprocess.run(cmd, check=True, capture_output=True, text=True, env=dict(os.environ, JAXCELT_CACHE_DIR="off"))
     ds = open_sweep(out)
+    # the terminal summary: its regime ranges cover every lane, with the dataset's labels
+    printed = _printed_ranges(run.stdout)
+    assert sum(k for *_, k, _ in printed) == ds.sizes["omega_pi"] == 2
+    for a, b, _, label in printed:
+        lanes = ds.sel(omega_pi=slice(a, b))
+        assert all(label.startswith(str(n)) for n in _labels(lanes))
+    assert "sweep.nc" in run.stdout and "open_sweep(" in run.stdout
     assert json.loads(ds.attrs["config_json"])["solver"] == "Dopri5"
     assert json.loads((out / "summary.json").read_text())["solver"] == "Dopri5"
     import diffrax
@@ -148,3 +155,77 @@ def test_bifurcation_rejects_unknown_solver(capsys):
         main(["bifurcation", "--solver", "RK45"])
     assert e.value.code == 2
     assert "invalid choice: 'RK45'" in capsys.readouterr().err
+
+
+def _labels(ds):
+    from jaxcelt.regimes import regime_names
+
+    return regime_names(ds["regime"].values, ds["period"].values)
+
+
+def _printed_ranges(stdout: str) -> list[tuple[float, float, int, str]]:
+    """(from, to, lanes, label) from the summary's lines ``  12.000 .. 13.000     2 lanes  period-1, bounded``."""
+    import re
+
+    pat = re.compile(r"^\s+([-\d.]+)(?: \.\. ([-\d.]+))?\s+(\d+) lanes?\s+(.+)$")
+    out = []
+    for line in stdout.splitlines():
+        m = pat.match(line)
+        if m:
+            a = float(m[1])
+            out.append((a, float(m[2]) if m[2] else a, int(m[3]), m[4].strip()))
+    return out
+
+
+def _fake_sweep():
+    # a hand-made dataset: 2 invalid lanes (lift-off, n3 <= 0), 2 period-1 bounded, 1 chaotic unbounded
+    import xarray as xr
+
+    w = np.array([10.0, 11.0, 12.0, 13.0, 14.0])
+    v = lambda a: ("omega_pi", np.array(a))
+    return xr.Dataset(
+        {
+            "regime": v([1, 1, 2, 2, 4]),
+            "period": v([0, 0, 1, 1, 0]),
+            "global_motion": v([-1, -1, 0, 0, 1]),
+            "valid": v(np.array([0, 0, 1, 1, 1], dtype=np.int8)),
+            "first_invalid_kind": v([1, 2, 0, 0, 0]),
+            "status": v([2, 2, 0, 0, 0]),
+            "lyapunov": v([np.nan, np.nan, -0.5, -0.25, 1.5]),
+        },
+        coords={"omega_pi": w},
+        attrs={
+            "swept_parameter": "omega_pi",
+            "config_json": json.dumps(
+                {"transient_periods": 100, "sample_periods": 30, "solver": "Tsit5", "rtol": 1e-8}
+            ),
+        },
+    )
+
+
+def test_bifurcation_summary_text(tmp_path):
+    from jaxcelt.commands.bifurcation import format_summary
+
+    text = format_summary(_fake_sweep(), wall_seconds=12.34, out=tmp_path, files=["summary.json", "sweep.nc"])
+    lines = text.splitlines()
+    assert _printed_ranges(text) == [
+        (10.0, 11.0, 2, "invalid"),
+        (12.0, 13.0, 2, "period-1, bounded"),
+        (14.0, 14.0, 1, "chaotic, unbounded"),
+    ]
+    assert lines[0].startswith("5 lanes, omega_pi 10 .. 14 rad/s; 100 transient + 30 sampled periods, Tsit5")
+    assert "12.3 s" in lines[0]
+    inv = next(x for x in lines if x.startswith("invalid lanes"))
+    assert "2 of 5" in inv and "10..11" in inv and "1 lift-off" in inv and "1 contact off" in inv
+    assert "largest Lyapunov exponent: -0.5 .. 1.5 1/s" in text
+    assert "lanes per regime: invalid 2, period-1, bounded 2, chaotic, unbounded 1" in text
+    assert f"open_sweep({str(tmp_path)!r})" in text and "summary.json, sweep.nc" in text
+    assert len(lines) <= 12  # short: no JSON dump
+
+
+def test_bifurcation_summary_caps_the_range_list(tmp_path):
+    from jaxcelt.commands.bifurcation import format_summary
+
+    ds = _fake_sweep()
+    text = format_summary(ds, wall_seconds=1.0, out=tmp_path, files=[], max_ranges=2)
+    assert len(_printed_ranges(text)) == 2 and "1 more ranges" in text

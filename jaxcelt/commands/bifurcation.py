@@ -125,6 +125,85 @@ def _ranges(ds, key: str = "regime") -> list[dict]:
     return out
 
 
+def regime_ranges(ds) -> list[tuple[float, float, int, str]]:
+    """Contiguous runs of lanes with the same label along the swept axis: ``(from, to, lanes, label)``.
+
+    The label is the local regime with the global motion of O (``"period-1, bounded"``), or
+    ``"invalid"`` for a lane that left the model's validity (its global motion is unknown).
+    A multi-start dataset is labelled by its first start."""
+    from jaxcelt.regimes import GLOBAL_MOTION, regime_names
+
+    vals = ds[ds.attrs["swept_parameter"]].values
+    reg, per, glob = ds["regime"].values, ds["period"].values, ds["global_motion"].values
+    if reg.ndim == 2:
+        reg, per, glob = reg[:, 0], per[:, 0], glob[:, 0]
+    labels = [
+        n if g == -1 and n in ("invalid", "failed") else f"{n}, {GLOBAL_MOTION[int(g)]}"
+        for n, g in zip(regime_names(reg, per), glob)
+    ]
+    out, start = [], 0
+    for i in range(1, len(vals) + 1):
+        if i == len(vals) or labels[i] != labels[start]:
+            out.append((float(vals[start]), float(vals[i - 1]), i - start, labels[start]))
+            start = i
+    return out
+
+
+def format_summary(ds, *, wall_seconds: float, out: Path, files: list[str], max_ranges: int = 30) -> str:
+    """The short report printed at the end of ``jaxcelt bifurcation`` (everything from the dataset ``ds``)."""
+    import collections
+
+    import numpy as np
+
+    from jaxcelt.solve import INVALID_KINDS
+
+    name = ds.attrs["swept_parameter"]
+    vals = ds[name].values
+    unit = " rad/s" if name == "omega_pi" else ""
+    cfg = json.loads(ds.attrs.get("config_json", "{}"))
+    first = (lambda a: a[:, 0]) if ds["regime"].ndim == 2 else (lambda a: a)
+    n = len(vals)
+    lines = [
+        f"{n} lanes, {name} {vals.min():g} .. {vals.max():g}{unit}; "
+        f"{cfg.get('transient_periods', '?')} transient + {cfg.get('sample_periods', '?')} sampled periods, "
+        f"{cfg.get('solver', '?')} rtol {cfg.get('rtol', '?')}; sweep {wall_seconds:.1f} s including compilation",
+        f"regimes by {name}{' [rad/s]' if unit else ''}:",
+    ]
+    ranges = regime_ranges(ds)
+    for a, b, k, label in ranges[:max_ranges]:
+        span = f"{a:8.3f}" if k == 1 else f"{a:8.3f} .. {b:.3f}"
+        lines.append(f"  {span:<20} {k:4d} lane{'s' if k > 1 else ' '}  {label}")
+    if len(ranges) > max_ranges:
+        lines.append(f"  ... {len(ranges) - max_ranges} more ranges (all in summary.json)")
+    counts = collections.Counter(label for *_, k, label in ranges for _ in range(k))
+    lines.append("lanes per regime: " + ", ".join(f"{label} {c}" for label, c in counts.most_common()))
+    valid = first(ds["valid"].values).astype(bool)
+    kinds = first(ds["first_invalid_kind"].values)
+    n_bad = int(np.sum(~valid))
+    if n_bad:
+        by_kind = collections.Counter(INVALID_KINDS.get(int(k), str(int(k))) for k in kinds[~valid])
+        where = ", ".join(f"{a:.4g}" if k == 1 else f"{a:.4g}..{b:.4g}" for a, b, k, lb in ranges if lb == "invalid")
+        lines.append(
+            f"invalid lanes (left the model's validity): {n_bad} of {n}, at {name} = {where}; "
+            + ", ".join(f"{c} {kind}" for kind, c in sorted(by_kind.items()))
+        )
+    else:
+        lines.append(f"invalid lanes: none of {n}")
+    status = first(ds["status"].values)
+    n_failed = int(np.sum(np.isin(status, (1, 3))))
+    if n_failed:
+        lines.append(f"solver failures (max_steps or error): {n_failed} lanes")
+    lam = ds["lyapunov"].values
+    if np.isfinite(lam).any():
+        lines.append(f"largest Lyapunov exponent: {np.nanmin(lam):.3g} .. {np.nanmax(lam):.3g} 1/s")
+    lines.append(f"wrote {out}/: " + ", ".join(files))
+    lines.append(
+        f"load: from jaxcelt.dataset import open_sweep; ds = open_sweep({str(out)!r})  "
+        f"# xarray.Dataset: ds.section, ds.regime, ds.lyapunov over ds.{name}"
+    )
+    return "\n".join(lines)
+
+
 def _set_host_devices(spec: str) -> int:
     """Ask JAX for ``spec`` CPU devices (before the backend starts); returns the count asked for."""
     import os
@@ -152,7 +231,7 @@ def run(args) -> int:
     import jaxcelt as jc
     from jaxcelt.benchmarking import make_solver
     from jaxcelt.dataset import open_sweep
-    from jaxcelt.sweep import DEFAULT_WIDTH, orbit, sweep
+    from jaxcelt.sweep import DEFAULT_WIDTH, sweep
     from jaxcelt.versions import versions_string
 
     # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2), before any work
@@ -216,10 +295,19 @@ def run(args) -> int:
         "regimes": _ranges(ds),
     }
     (args.out / "summary.json").write_text(json.dumps(summary, indent=1))
-    print(json.dumps(summary, indent=1))
-    if args.no_figures:
-        return 0
+    if not args.no_figures:
+        _figures(args, ds, params, omega0, solver)
+    files = sorted(f.name for f in args.out.iterdir() if f.is_file() and f.name != "manifest.json")
+    print(format_summary(ds, wall_seconds=wall, out=args.out, files=files), flush=True)
+    return 0
+
+
+def _figures(args, ds, params, omega0, solver) -> None:
     import matplotlib
+    import numpy as np
+
+    import jaxcelt as jc
+    from jaxcelt.sweep import orbit
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -249,5 +337,3 @@ def run(args) -> int:
             fig = orbit_figure(o["ts"], o["ys"], o["r_O"], o["section_index"], omega_pi=float(w), label=label)
             fig.savefig(args.out / f"orbit_omega{w:g}.png", dpi=130)
             plt.close(fig)
-    print(f"wrote {args.out}", flush=True)
-    return 0
