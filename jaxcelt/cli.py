@@ -2,32 +2,47 @@
 
 A thin layer: each command lives in `jaxcelt.commands.<name>` with ``register(subparsers)``
 adding its parser and a ``func(args) -> int``; the physics is in the library.
+
+Bad input is reported in one place: an argparse error, or a ``ValueError`` raised while a
+command checks its input (the library names the parameter), prints one line
+``jaxcelt <command>: error: <message>`` to stderr and exits with status 2. Set
+``JAXCELT_TRACEBACK=1`` to see the traceback instead.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 # Each entry is a module in jaxcelt.commands exposing register(subparsers).
 COMMANDS: tuple[str, ...] = ("simulate", "bifurcation", "fit", "ladder")
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """An `argparse.ArgumentParser` whose errors are one line, ``<prog>: error: <message>``, on
+    stderr, exit status 2 (argparse's default also prints the usage block). Subparsers inherit it."""
+
+    def error(self, message: str):  # type: ignore[override]
+        one_line = " ".join(str(message).split())
+        self.exit(2, f"{self.prog}: error: {one_line}\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="jaxcelt", description=__doc__.splitlines()[0])
+    parser = OneLineParser(prog="jaxcelt", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="store_true", help="print package and JAX versions and exit")
     sub = parser.add_subparsers(dest="command")
     for name in COMMANDS:
         importlib.import_module(f"jaxcelt.commands.{name}").register(sub)
+    for command_parser in sub.choices.values():  # main() reports a command's ValueError through its parser
+        command_parser.set_defaults(command_parser=command_parser)
     return parser
 
 
 def _enable_compile_cache() -> None:
     """Persistent XLA compilation cache for the command line (a rerun or a resumed sweep skips
     the compile). Directory: $JAXCELT_CACHE_DIR, default ~/.cache/jaxcelt/xla; "off" disables."""
-    import os
-
     import jax
 
     d = os.environ.get("JAXCELT_CACHE_DIR", os.path.join(os.path.expanduser("~"), ".cache", "jaxcelt", "xla"))
@@ -49,7 +64,13 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:
         parser.print_help()
         return 2
-    return int(args.func(args) or 0)
+    try:
+        return int(args.func(args) or 0)
+    except ValueError as e:  # bad input found while the command checks it (the message names the parameter)
+        if os.environ.get("JAXCELT_TRACEBACK", "").strip() not in ("", "0"):
+            raise
+        args.command_parser.error(str(e))
+        raise  # pragma: no cover  (error() exits)
 
 
 if __name__ == "__main__":  # pragma: no cover

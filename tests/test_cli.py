@@ -6,6 +6,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from jaxcelt.cli import main
 from jaxcelt.io import load_trajectory
@@ -25,9 +26,75 @@ def test_simulate_writes_data_and_figure(tmp_path):
 
 
 def test_simulate_rejects_bad_parameter(tmp_path, capsys):
-    rc = main(["simulate", "--set", "m=-1", "--out", str(tmp_path)])
-    assert rc == 2
-    assert "'m'" in capsys.readouterr().out
+    with pytest.raises(SystemExit) as e:
+        main(["simulate", "--set", "m=-1", "--out", str(tmp_path)])
+    assert e.value.code == 2
+    assert "'m'" in capsys.readouterr().err
+    assert not tmp_path.joinpath("celt_w17.npz").exists()
+
+
+# Bad input in every command: one line "jaxcelt <command>: error: <message naming the parameter>"
+# on stderr, exit status 2, nothing on stdout, no traceback; checked before any integration runs.
+BAD_INPUT = [
+    (["bifurcation", "--set", "mu=-1"], "'mu'"),
+    (["bifurcation", "--set", "nonsense=3"], "nonsense"),
+    (["bifurcation", "--set", "mu"], "--set"),
+    (["bifurcation", "--omega", "14:15:abc"], "--omega"),
+    (["bifurcation", "--omega", "14:15"], "--omega"),
+    (["bifurcation", "--omega", "14:15:0"], "--omega"),
+    (["bifurcation", "--transient", "-3"], "--transient"),
+    (["bifurcation", "--sample", "0"], "--sample"),
+    (["bifurcation", "--lyapunov", "x"], "--lyapunov"),
+    (["bifurcation", "--rtol", "-1"], "--rtol"),
+    (["bifurcation", "--omega0", "1,2"], "--omega0"),
+    (["bifurcation", "--host-devices", "0"], "--host-devices"),
+    (["bifurcation", "--param", "nonsense", "--values", "1,2"], "--param"),
+    (["bifurcation", "--param", "mu"], "--values"),
+    (["bifurcation", "--param", "mu", "--values", "0.1,-0.2"], "'mu'"),
+    (["simulate", "--set", "m=-1"], "'m'"),
+    (["simulate", "--periods", "0"], "--periods"),
+    (["simulate", "--omega-pi", "nan"], "--omega-pi"),
+    (["simulate", "--n0", "0,0"], "--n0"),
+    (["ladder", "--scene", "nonsense"], "--scene"),
+    (["ladder", "--laws", "pade,nonsense"], "--laws"),
+    (["ladder", "--tol", "-1"], "--tol"),
+    (["fit", "missing.npz", "--set", "mu=-1"], "'mu'"),
+    (["fit", "missing.npz", "--max-iter", "0"], "--max-iter"),
+    (["fit", "missing.npz"], "missing.npz"),
+]
+
+
+@pytest.mark.parametrize("argv,named", BAD_INPUT, ids=[" ".join(a) for a, _ in BAD_INPUT])
+def test_bad_input_is_one_error_line(argv, named, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # outputs (if any were written) land here; "missing.npz" does not exist
+    monkeypatch.delenv("JAXCELT_TRACEBACK", raising=False)
+    monkeypatch.setenv("JAXCELT_CACHE_DIR", "off")
+    with pytest.raises(SystemExit) as e:
+        main(argv)
+    assert e.value.code == 2
+    out, err = capsys.readouterr()
+    lines = err.splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith(f"jaxcelt {argv[0]}: error: "), lines[0]
+    assert named in lines[0]
+    assert "Traceback" not in err and out == ""
+    assert not any(tmp_path.iterdir())  # rejected before anything was written
+
+
+def test_bad_input_traceback_on_request(monkeypatch):
+    # JAXCELT_TRACEBACK=1: the ValueError itself (for debugging), not the one-line report
+    monkeypatch.setenv("JAXCELT_TRACEBACK", "1")
+    monkeypatch.setenv("JAXCELT_CACHE_DIR", "off")
+    with pytest.raises(ValueError, match="'mu'"):
+        main(["bifurcation", "--set", "mu=-1"])
+
+
+def test_bad_input_from_the_shell():
+    # the installed entry point (python -m jaxcelt): exit status 2 and one stderr line
+    cmd = [sys.executable, "-m", "jaxcelt", "bifurcation", "--set", "mu=-1"]
+    r = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ, JAXCELT_CACHE_DIR="off"))
+    assert r.returncode == 2
+    assert r.stderr.splitlines() == ["jaxcelt bifurcation: error: parameter 'mu' must be >= 0, got -1.0"]
 
 
 def test_import_does_not_start_the_jax_backend():
@@ -61,8 +128,15 @@ def test_bifurcation_solver_option(tmp_path):
     cmd = [sys.executable, "-m", "jaxcelt", "bifurcation", "--omega", "14,17", "--transient", "1", "--sample", "2",
            "--lyapunov", "0", "--orbits", "", "--solver", "Dopri5", "--host-devices", "1", "--no-figures",
            "--out", str(out)]  # fmt: skip
-    subprocess.run(cmd, check=True, capture_output=True, env=dict(os.environ, JAXCELT_CACHE_DIR="off"))
+    run = subprocess.run(cmd, check=True, capture_output=True, text=True, env=dict(os.environ, JAXCELT_CACHE_DIR="off"))
     ds = open_sweep(out)
+    # the terminal summary: its regime ranges cover every lane, with the dataset's labels
+    printed = _printed_ranges(run.stdout)
+    assert sum(k for *_, k, _ in printed) == ds.sizes["omega_pi"] == 2
+    for a, b, _, label in printed:
+        lanes = ds.sel(omega_pi=slice(a, b))
+        assert all(label.startswith(str(n)) for n in _labels(lanes))
+    assert "sweep.nc" in run.stdout and "open_sweep(" in run.stdout
     assert json.loads(ds.attrs["config_json"])["solver"] == "Dopri5"
     assert json.loads((out / "summary.json").read_text())["solver"] == "Dopri5"
     import diffrax
@@ -77,9 +151,81 @@ def test_bifurcation_solver_option(tmp_path):
 
 
 def test_bifurcation_rejects_unknown_solver(capsys):
-    import pytest
-
     with pytest.raises(SystemExit) as e:
         main(["bifurcation", "--solver", "RK45"])
     assert e.value.code == 2
     assert "invalid choice: 'RK45'" in capsys.readouterr().err
+
+
+def _labels(ds):
+    from jaxcelt.regimes import regime_names
+
+    return regime_names(ds["regime"].values, ds["period"].values)
+
+
+def _printed_ranges(stdout: str) -> list[tuple[float, float, int, str]]:
+    """(from, to, lanes, label) from the summary's lines ``  12.000 .. 13.000     2 lanes  period-1, bounded``."""
+    import re
+
+    pat = re.compile(r"^\s+([-\d.]+)(?: \.\. ([-\d.]+))?\s+(\d+) lanes?\s+(.+)$")
+    out = []
+    for line in stdout.splitlines():
+        m = pat.match(line)
+        if m:
+            a = float(m[1])
+            out.append((a, float(m[2]) if m[2] else a, int(m[3]), m[4].strip()))
+    return out
+
+
+def _fake_sweep():
+    # a hand-made dataset: 2 invalid lanes (lift-off, n3 <= 0), 2 period-1 bounded, 1 chaotic unbounded
+    import xarray as xr
+
+    w = np.array([10.0, 11.0, 12.0, 13.0, 14.0])
+    v = lambda a: ("omega_pi", np.array(a))
+    return xr.Dataset(
+        {
+            "regime": v([1, 1, 2, 2, 4]),
+            "period": v([0, 0, 1, 1, 0]),
+            "global_motion": v([-1, -1, 0, 0, 1]),
+            "valid": v(np.array([0, 0, 1, 1, 1], dtype=np.int8)),
+            "first_invalid_kind": v([1, 2, 0, 0, 0]),
+            "status": v([2, 2, 0, 0, 0]),
+            "lyapunov": v([np.nan, np.nan, -0.5, -0.25, 1.5]),
+        },
+        coords={"omega_pi": w},
+        attrs={
+            "swept_parameter": "omega_pi",
+            "config_json": json.dumps(
+                {"transient_periods": 100, "sample_periods": 30, "solver": "Tsit5", "rtol": 1e-8}
+            ),
+        },
+    )
+
+
+def test_bifurcation_summary_text(tmp_path):
+    from jaxcelt.commands.bifurcation import format_summary
+
+    text = format_summary(_fake_sweep(), wall_seconds=12.34, out=tmp_path, files=["summary.json", "sweep.nc"])
+    lines = text.splitlines()
+    assert _printed_ranges(text) == [
+        (10.0, 11.0, 2, "invalid"),
+        (12.0, 13.0, 2, "period-1, bounded"),
+        (14.0, 14.0, 1, "chaotic, unbounded"),
+    ]
+    assert lines[0].startswith("5 lanes, omega_pi 10 .. 14 rad/s; 100 transient + 30 sampled periods, Tsit5")
+    assert "12.3 s" in lines[0]
+    inv = next(x for x in lines if x.startswith("invalid lanes"))
+    assert "2 of 5" in inv and "10..11" in inv and "1 lift-off" in inv and "1 contact off" in inv
+    assert "largest Lyapunov exponent: -0.5 .. 1.5 1/s" in text
+    assert "lanes per regime: invalid 2, period-1, bounded 2, chaotic, unbounded 1" in text
+    assert f"open_sweep({str(tmp_path)!r})" in text and "summary.json, sweep.nc" in text
+    assert len(lines) <= 12  # short: no JSON dump
+
+
+def test_bifurcation_summary_caps_the_range_list(tmp_path):
+    from jaxcelt.commands.bifurcation import format_summary
+
+    ds = _fake_sweep()
+    text = format_summary(ds, wall_seconds=1.0, out=tmp_path, files=[], max_ranges=2)
+    assert len(_printed_ranges(text)) == 2 and "1 more ranges" in text

@@ -12,6 +12,8 @@ import json
 import time
 from pathlib import Path
 
+from .args import UsageError, floats, nonnegative_int, override, overrides, positive_float, positive_int, value_range
+
 SWEEP_SOLVERS = ("Tsit5", "Dopri5", "Dopri8")  # names in jaxcelt.benchmarking.SOLVERS
 
 
@@ -22,20 +24,33 @@ def register(sub) -> None:
         description=__doc__.splitlines()[0],
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
-    p.add_argument("--omega", default="10:20:60", help="omega_pi values [rad/s]: START:STOP:COUNT or a,b,c")
+    p.add_argument(
+        "--omega", type=value_range, default="10:20:60", help="omega_pi values [rad/s]: START:STOP:COUNT or a,b,c"
+    )
     p.add_argument("--param", default="omega_pi", help="swept CeltParams field (values from --values)")
     p.add_argument(
-        "--values", default=None, help="values of --param when it is not omega_pi (START:STOP:COUNT or list)"
+        "--values",
+        type=value_range,
+        default=None,
+        help="values of --param when it is not omega_pi (START:STOP:COUNT or list)",
     )
-    p.add_argument("--transient", type=int, default=100, help="transient forcing periods discarded")
-    p.add_argument("--sample", type=int, default=30, help="stroboscopic samples (periods) kept")
+    p.add_argument("--transient", type=nonnegative_int, default=100, help="transient forcing periods discarded")
+    p.add_argument("--sample", type=positive_int, default=30, help="stroboscopic samples (periods) kept")
     p.add_argument(
-        "--lyapunov", type=int, default=30, help="periods of tangent dynamics for the Lyapunov exponent (0: off)"
+        "--lyapunov",
+        type=nonnegative_int,
+        default=30,
+        help="periods of tangent dynamics for the Lyapunov exponent (0: off)",
     )
     p.add_argument(
-        "--set", action="append", default=[], metavar="NAME=VALUE", help="override any CeltParams field, repeatable"
+        "--set",
+        action="append",
+        type=override,
+        default=[],
+        metavar="NAME=VALUE",
+        help="override any CeltParams field, repeatable",
     )
-    p.add_argument("--omega0", default="0,0,0", help="initial omega (body) [rad/s]")
+    p.add_argument("--omega0", type=floats(3), default="0,0,0", help="initial omega (body) [rad/s]")
     p.add_argument(
         "--solver",
         default="Tsit5",
@@ -44,18 +59,18 @@ def register(sub) -> None:
         "8th-order Dormand-Prince family as scipy's DOP853: at rtol 1e-8 about 25x more accurate than Tsit5, "
         "as fast per sweep, but it compiles longer",
     )
-    p.add_argument("--rtol", type=float, default=1e-8)
-    p.add_argument("--atol", type=float, default=1e-10)
-    p.add_argument("--max-steps", type=int, default=1_000_000)
+    p.add_argument("--rtol", type=positive_float, default=1e-8)
+    p.add_argument("--atol", type=positive_float, default=1e-10)
+    p.add_argument("--max-steps", type=positive_int, default=1_000_000)
     p.add_argument(
         "--chunk-size",
-        type=int,
+        type=positive_int,
         default=200,
         help="lanes per jitted pool launch (the unit of resumable writing); split over the devices",
     )
     p.add_argument(
         "--width",
-        type=int,
+        type=positive_int,
         default=None,
         help="pool slots per device: lanes stepped side by side (vmap width; default jaxcelt.sweep.DEFAULT_WIDTH)",
     )
@@ -72,8 +87,13 @@ def register(sub) -> None:
         help="end a lane at its first invalid state (lift-off or n3 <= 0; the model does not hold past it): "
         "label 'invalid', later samples inf, no Lyapunov exponent. --no-stop-on-invalid integrates on",
     )
-    p.add_argument("--orbits", default="14,15.6,17,19", help="omega_pi values for phase-plot figures ('' for none)")
-    p.add_argument("--orbit-periods", type=int, default=40, help="periods shown in the phase plots")
+    p.add_argument(
+        "--orbits",
+        type=value_range,
+        default="14,15.6,17,19",
+        help="omega_pi values for phase-plot figures ('' for none)",
+    )
+    p.add_argument("--orbit-periods", type=positive_int, default=40, help="periods shown in the phase plots")
     p.add_argument("--out", type=Path, default=Path("out/bifurcation"), help="output directory (resumable)")
     p.add_argument("--no-figures", action="store_true")
     p.set_defaults(func=run)
@@ -105,15 +125,97 @@ def _ranges(ds, key: str = "regime") -> list[dict]:
     return out
 
 
+def regime_ranges(ds) -> list[tuple[float, float, int, str]]:
+    """Contiguous runs of lanes with the same label along the swept axis: ``(from, to, lanes, label)``.
+
+    The label is the local regime with the global motion of O (``"period-1, bounded"``), or
+    ``"invalid"`` for a lane that left the model's validity (its global motion is unknown).
+    A multi-start dataset is labelled by its first start."""
+    from jaxcelt.regimes import GLOBAL_MOTION, regime_names
+
+    vals = ds[ds.attrs["swept_parameter"]].values
+    reg, per, glob = ds["regime"].values, ds["period"].values, ds["global_motion"].values
+    if reg.ndim == 2:
+        reg, per, glob = reg[:, 0], per[:, 0], glob[:, 0]
+    labels = [
+        n if g == -1 and n in ("invalid", "failed") else f"{n}, {GLOBAL_MOTION[int(g)]}"
+        for n, g in zip(regime_names(reg, per), glob)
+    ]
+    out, start = [], 0
+    for i in range(1, len(vals) + 1):
+        if i == len(vals) or labels[i] != labels[start]:
+            out.append((float(vals[start]), float(vals[i - 1]), i - start, labels[start]))
+            start = i
+    return out
+
+
+def format_summary(ds, *, wall_seconds: float, out: Path, files: list[str], max_ranges: int = 30) -> str:
+    """The short report printed at the end of ``jaxcelt bifurcation`` (everything from the dataset ``ds``)."""
+    import collections
+
+    import numpy as np
+
+    from jaxcelt.solve import INVALID_KINDS
+
+    name = ds.attrs["swept_parameter"]
+    vals = ds[name].values
+    unit = " rad/s" if name == "omega_pi" else ""
+    cfg = json.loads(ds.attrs.get("config_json", "{}"))
+    first = (lambda a: a[:, 0]) if ds["regime"].ndim == 2 else (lambda a: a)
+    n = len(vals)
+    lines = [
+        f"{n} lanes, {name} {vals.min():g} .. {vals.max():g}{unit}; "
+        f"{cfg.get('transient_periods', '?')} transient + {cfg.get('sample_periods', '?')} sampled periods, "
+        f"{cfg.get('solver', '?')} rtol {cfg.get('rtol', '?')}; sweep {wall_seconds:.1f} s including compilation",
+        f"regimes by {name}{' [rad/s]' if unit else ''}:",
+    ]
+    ranges = regime_ranges(ds)
+    for a, b, k, label in ranges[:max_ranges]:
+        span = f"{a:8.3f}" if k == 1 else f"{a:8.3f} .. {b:.3f}"
+        lines.append(f"  {span:<20} {k:4d} lane{'s' if k > 1 else ' '}  {label}")
+    if len(ranges) > max_ranges:
+        lines.append(f"  ... {len(ranges) - max_ranges} more ranges (all in summary.json)")
+    counts = collections.Counter(label for *_, k, label in ranges for _ in range(k))
+    lines.append("lanes per regime: " + ", ".join(f"{label} {c}" for label, c in counts.most_common()))
+    valid = first(ds["valid"].values).astype(bool)
+    kinds = first(ds["first_invalid_kind"].values)
+    n_bad = int(np.sum(~valid))
+    if n_bad:
+        by_kind = collections.Counter(INVALID_KINDS.get(int(k), str(int(k))) for k in kinds[~valid])
+        where = ", ".join(f"{a:.4g}" if k == 1 else f"{a:.4g}..{b:.4g}" for a, b, k, lb in ranges if lb == "invalid")
+        lines.append(
+            f"invalid lanes (left the model's validity): {n_bad} of {n}, at {name} = {where}; "
+            + ", ".join(f"{c} {kind}" for kind, c in sorted(by_kind.items()))
+        )
+    else:
+        lines.append(f"invalid lanes: none of {n}")
+    status = first(ds["status"].values)
+    n_failed = int(np.sum(np.isin(status, (1, 3))))
+    if n_failed:
+        lines.append(f"solver failures (max_steps or error): {n_failed} lanes")
+    lam = ds["lyapunov"].values
+    if np.isfinite(lam).any():
+        lines.append(f"largest Lyapunov exponent: {np.nanmin(lam):.3g} .. {np.nanmax(lam):.3g} 1/s")
+    lines.append(f"wrote {out}/: " + ", ".join(files))
+    lines.append(
+        f"load: from jaxcelt.dataset import open_sweep; ds = open_sweep({str(out)!r})  "
+        f"# xarray.Dataset: ds.section, ds.regime, ds.lyapunov over ds.{name}"
+    )
+    return "\n".join(lines)
+
+
 def _set_host_devices(spec: str) -> int:
     """Ask JAX for ``spec`` CPU devices (before the backend starts); returns the count asked for."""
     import os
 
     import jax
 
-    n = (os.cpu_count() or 1) if spec == "auto" else int(spec)
+    try:
+        n = (os.cpu_count() or 1) if spec == "auto" else int(spec)
+    except ValueError:
+        n = 0
     if n < 1:
-        raise SystemExit(f"--host-devices must be >= 1 or 'auto', got {spec!r}")
+        raise UsageError(f"argument --host-devices: must be an integer >= 1 or 'auto', got {spec!r}")
     try:
         jax.config.update("jax_num_cpu_devices", n)
     except RuntimeError:  # backend already started (e.g. called from Python after JAX work)
@@ -128,17 +230,26 @@ def run(args) -> int:
 
     import jaxcelt as jc
     from jaxcelt.benchmarking import make_solver
-    from jaxcelt.commands.simulate import parse_overrides
     from jaxcelt.dataset import open_sweep
-    from jaxcelt.sweep import DEFAULT_WIDTH, orbit, parse_range, sweep
+    from jaxcelt.sweep import DEFAULT_WIDTH, sweep
     from jaxcelt.versions import versions_string
 
-    print(versions_string(), flush=True)
-    params = jc.CeltParams.paper(**parse_overrides(args.set))
-    values = parse_range(args.omega if args.param == "omega_pi" else (args.values or ""))
+    # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2), before any work
+    params = jc.CeltParams.paper(**overrides(args.set))
+    if args.param not in jc.PARAM_NAMES:
+        raise UsageError(f"argument --param: unknown parameter {args.param!r}; known: {', '.join(jc.PARAM_NAMES)}")
+    if args.param == "omega_pi":
+        values = args.omega
+    elif args.values is None:
+        raise UsageError(f"argument --values: required with --param {args.param}")
+    else:
+        values = args.values
     if values.size == 0:
-        raise SystemExit("no values to sweep (use --omega, or --values with --param)")
-    omega0 = [float(x) for x in args.omega0.split(",")]
+        raise UsageError("argument --omega/--values: no values to sweep")
+    for v in values:  # each lane's parameters must be valid too
+        params.replace(**{args.param: float(v)})
+    omega0 = args.omega0
+    print(versions_string(), flush=True)
     y0 = np.asarray(jc.initial_state(params, omega=omega0))
     args.out.mkdir(parents=True, exist_ok=True)
     solver = make_solver(args.solver)
@@ -184,10 +295,19 @@ def run(args) -> int:
         "regimes": _ranges(ds),
     }
     (args.out / "summary.json").write_text(json.dumps(summary, indent=1))
-    print(json.dumps(summary, indent=1))
-    if args.no_figures:
-        return 0
+    if not args.no_figures:
+        _figures(args, ds, params, omega0, solver)
+    files = sorted(f.name for f in args.out.iterdir() if f.is_file() and f.name != "manifest.json")
+    print(format_summary(ds, wall_seconds=wall, out=args.out, files=files), flush=True)
+    return 0
+
+
+def _figures(args, ds, params, omega0, solver) -> None:
     import matplotlib
+    import numpy as np
+
+    import jaxcelt as jc
+    from jaxcelt.sweep import orbit
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -201,8 +321,8 @@ def run(args) -> int:
         fig = bifurcation_figure(ds, color_by="lyapunov")
         fig.savefig(args.out / "bifurcation_lyapunov.png", dpi=150)
         plt.close(fig)
-    if args.param == "omega_pi" and args.orbits.strip():
-        for w in parse_range(args.orbits):
+    if args.param == "omega_pi" and args.orbits.size:
+        for w in args.orbits:
             pw = params.replace(omega_pi=float(w))
             o = orbit(
                 pw,
@@ -217,5 +337,3 @@ def run(args) -> int:
             fig = orbit_figure(o["ts"], o["ys"], o["r_O"], o["section_index"], omega_pi=float(w), label=label)
             fig.savefig(args.out / f"orbit_omega{w:g}.png", dpi=130)
             plt.close(fig)
-    print(f"wrote {args.out}", flush=True)
-    return 0

@@ -10,6 +10,8 @@ import argparse
 import json
 from pathlib import Path
 
+from .args import UsageError, override, overrides, positive_float, positive_int
+
 
 def register(sub) -> None:
     p = sub.add_parser(
@@ -23,6 +25,7 @@ def register(sub) -> None:
     p.add_argument(
         "--set",
         action="append",
+        type=override,
         default=[],
         metavar="NAME=VALUE",
         help="starting/fixed value of any CeltParams field (default: paper)",
@@ -31,11 +34,13 @@ def register(sub) -> None:
         "--kinds", nargs="+", default=None, help="use only these observation kinds (state omega orientation centre)"
     )
     p.add_argument("--optimiser", choices=("lm", "gn", "gn-damped", "adam", "lbfgs"), default="lm")
-    p.add_argument("--windows", type=int, default=1, help="multiple-shooting windows per record (1 = single shooting)")
+    p.add_argument(
+        "--windows", type=positive_int, default=1, help="multiple-shooting windows per record (1 = single shooting)"
+    )
     p.add_argument("--window-states", choices=("optimise", "data"), default="optimise")
     p.add_argument("--fit-y0", action="store_true", help="also optimise the first initial state")
-    p.add_argument("--max-iter", type=int, default=100)
-    p.add_argument("--learning-rate", type=float, default=0.02, help="Adam step size")
+    p.add_argument("--max-iter", type=positive_int, default=100)
+    p.add_argument("--learning-rate", type=positive_float, default=0.02, help="Adam step size")
     p.add_argument("--out", type=Path, default=Path("out/fit"), help="output directory (fit.json, fit.png)")
     p.add_argument("--no-plot", action="store_true")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -46,18 +51,19 @@ def run(args) -> int:
     from tqdm import tqdm
 
     import jaxcelt as jc
-    from jaxcelt.commands.simulate import parse_overrides
     from jaxcelt.data import load_data
     from jaxcelt.fit import fit
 
+    # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2)
+    params0 = jc.CeltParams.paper(**overrides(args.set))
     try:
         data = load_data(args.data)
-        if args.kinds:
-            data = data.subset(args.kinds)
-        params0 = jc.CeltParams.paper(**parse_overrides(args.set))
-    except (ValueError, OSError, KeyError) as e:
-        print(f"jaxcelt fit: {e}")
-        return 2
+    except (OSError, KeyError) as e:
+        raise UsageError(f"argument data: cannot read {str(args.data)!r}: {e}") from e
+    except ValueError as e:
+        raise UsageError(f"argument data: {str(args.data)!r}: {e}") from e
+    if args.kinds:
+        data = data.subset(args.kinds)
     bar = tqdm(total=args.max_iter, disable=args.quiet, desc=f"fit ({args.optimiser})", unit="it")
 
     def progress(it, loss, values):
@@ -77,11 +83,8 @@ def run(args) -> int:
             learning_rate=args.learning_rate,
             callback=progress,
         )
-    except ValueError as e:
+    finally:
         bar.close()
-        print(f"jaxcelt fit: {e}")
-        return 2
-    bar.close()
     print(res.summary())
     args.out.mkdir(parents=True, exist_ok=True)
     from jaxcelt.versions import versions

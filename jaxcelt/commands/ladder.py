@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 
+from .args import UsageError, positive_float
+
 
 def register(sub) -> None:
     p = sub.add_parser(
@@ -12,7 +14,9 @@ def register(sub) -> None:
     p.add_argument(
         "--scene", default="fast_spin", help="built-in scene: spin_reversal, base14, base19, fast_spin, or 'all'"
     )
-    p.add_argument("--tol", type=float, default=0.05, help="relative error tolerance on the observed quantities")
+    p.add_argument(
+        "--tol", type=positive_float, default=0.05, help="relative error tolerance on the observed quantities"
+    )
     p.add_argument("--laws", default=None, help="comma-separated rung names (default: the whole ladder)")
     p.add_argument("--short", action="store_true", help="halve the horizons")
     p.add_argument("--json", default=None, help="write results to this JSON file")
@@ -26,14 +30,14 @@ def run(args) -> int:
     names = list(scenes) if args.scene == "all" else [args.scene]
     for n in names:
         if n not in scenes:
-            raise SystemExit(f"unknown scene {n!r}; known: {sorted(scenes)}")
+            raise UsageError(f"argument --scene: unknown scene {n!r}; known: {', '.join(sorted(scenes))}, all")
     ladder = default_ladder()
     if args.laws:
         want = ["integral"] + [w for w in args.laws.split(",") if w != "integral"]
         known = {r.name: r for r in ladder}
         bad = [w for w in want if w not in known]
         if bad:
-            raise SystemExit(f"unknown law(s) {bad}; known: {sorted(known)}")
+            raise UsageError(f"argument --laws: unknown law(s) {', '.join(bad)}; known: {', '.join(sorted(known))}")
         ladder = tuple(known[w] for w in want)
     results = {n: run_ladder(scenes[n], ladder) for n in names}
     print(results_table(results, args.tol))

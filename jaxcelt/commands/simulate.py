@@ -7,15 +7,7 @@ import json
 import time
 from pathlib import Path
 
-
-def _floats(n):
-    def parse(s: str):
-        vals = [float(x) for x in s.split(",")]
-        if len(vals) != n:
-            raise argparse.ArgumentTypeError(f"expected {n} comma-separated numbers, got {s!r}")
-        return vals
-
-    return parse
+from .args import finite_float, floats, override, overrides, positive_float, positive_int
 
 
 def register(sub) -> None:
@@ -25,34 +17,27 @@ def register(sub) -> None:
         description="Integrate the stone on the vibrating base (paper's parameters unless overridden).",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
-    p.add_argument("--omega-pi", type=float, default=17.0, help="base frequency omega_pi [rad/s]")
-    p.add_argument("--q-pi", type=float, default=0.04, help="base amplitude q_pi [m]")
-    p.add_argument("--periods", type=float, default=20.0, help="duration in forcing periods 2 pi/omega_pi")
-    p.add_argument("--samples-per-period", type=int, default=50, help="saved states per period")
+    p.add_argument("--omega-pi", type=finite_float, default=17.0, help="base frequency omega_pi [rad/s]")
+    p.add_argument("--q-pi", type=finite_float, default=0.04, help="base amplitude q_pi [m]")
+    p.add_argument("--periods", type=positive_float, default=20.0, help="duration in forcing periods 2 pi/omega_pi")
+    p.add_argument("--samples-per-period", type=positive_int, default=50, help="saved states per period")
+    p.add_argument("--omega0", type=floats(3), default=[0.0, 0.0, 0.0], help="initial omega (body) [rad/s], 'w1,w2,w3'")
+    p.add_argument("--n0", type=floats(3), default=[0.0, 0.0, 1.0], help="initial vertical in body axes (normalised)")
+    p.add_argument("--psi0", type=finite_float, default=0.0, help="initial heading psi [rad]")
     p.add_argument(
-        "--omega0", type=_floats(3), default=[0.0, 0.0, 0.0], help="initial omega (body) [rad/s], 'w1,w2,w3'"
+        "--set",
+        action="append",
+        type=override,
+        default=[],
+        metavar="NAME=VALUE",
+        help="override any CeltParams field, repeatable",
     )
-    p.add_argument("--n0", type=_floats(3), default=[0.0, 0.0, 1.0], help="initial vertical in body axes (normalised)")
-    p.add_argument("--psi0", type=float, default=0.0, help="initial heading psi [rad]")
-    p.add_argument(
-        "--set", action="append", default=[], metavar="NAME=VALUE", help="override any CeltParams field, repeatable"
-    )
-    p.add_argument("--rtol", type=float, default=1e-8)
-    p.add_argument("--atol", type=float, default=1e-10)
+    p.add_argument("--rtol", type=positive_float, default=1e-8)
+    p.add_argument("--atol", type=positive_float, default=1e-10)
     p.add_argument("--stop-on-invalid", action="store_true", help="stop at lift-off or n3 <= 0")
     p.add_argument("--out", type=Path, default=Path("out/simulate"), help="output directory")
     p.add_argument("--no-plot", action="store_true")
     p.set_defaults(func=run)
-
-
-def parse_overrides(items: list[str]) -> dict[str, float]:
-    out = {}
-    for item in items:
-        if "=" not in item:
-            raise SystemExit(f"--set expects NAME=VALUE, got {item!r}")
-        k, v = item.split("=", 1)
-        out[k.strip()] = float(v)
-    return out
 
 
 def run(args) -> int:
@@ -61,15 +46,9 @@ def run(args) -> int:
     import jaxcelt as jc
     from jaxcelt.io import save_trajectory
 
-    try:
-        params = jc.CeltParams.paper(omega_pi=args.omega_pi, q_pi=args.q_pi, **parse_overrides(args.set))
-        y0 = jc.initial_state(params, omega=args.omega0, n=args.n0, psi=args.psi0, normalize=True)
-    except ValueError as e:
-        print(f"error: {e}")
-        return 2
-    if args.periods <= 0 or args.samples_per_period < 1:
-        print("error: --periods must be > 0 and --samples-per-period >= 1")
-        return 2
+    # a bad value raises ValueError naming the parameter: jaxcelt.cli prints it as one error line, exit 2
+    params = jc.CeltParams.paper(**(dict(omega_pi=args.omega_pi, q_pi=args.q_pi) | overrides(args.set)))
+    y0 = jc.initial_state(params, omega=args.omega0, n=args.n0, psi=args.psi0, normalize=True)
     T = 2 * np.pi / args.omega_pi if args.omega_pi > 0 else 1.0
     t1 = args.periods * T
     ts = np.linspace(0.0, t1, int(round(args.periods * args.samples_per_period)) + 1)
