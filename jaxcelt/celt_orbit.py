@@ -41,7 +41,7 @@ from .params import CeltParams
 from .periodic import ORBIT_STATUS, find_periodic_orbit, sort_multipliers, stroboscopic_map
 from .state import check_state
 
-__all__ = ["CeltOrbit", "periodic_orbit", "celt_chart", "celt_embed", "ORBIT_STATUS"]
+__all__ = ["CeltOrbit", "periodic_orbit", "continue_orbit", "celt_chart", "celt_embed", "ORBIT_STATUS"]
 
 
 def _basis(n0: Array) -> tuple[Array, Array]:
@@ -246,4 +246,52 @@ def periodic_orbit(
         max_steps=max_steps,
         newton_tol=newton_tol,
         newton_max_steps=newton_max_steps,
+    )
+
+
+def continue_orbit(
+    params: CeltParams,
+    orbit: CeltOrbit,
+    name: str,
+    values: ArrayLike,
+    *,
+    contact_law: AbstractContactLaw | str | None = None,
+    solver: diffrax.AbstractSolver | None = None,
+    rtol: float = 1e-11,
+    atol: float = 1e-12,
+    max_steps: int = 200_000,
+    newton_tol: float = 1e-9,
+    locate: bool = True,
+):
+    """Follow ``orbit`` (found at ``params``) in the parameter ``name`` over ``values``.
+
+    Natural continuation with period-doubling / fold / Neimark-Sacker detection
+    (`jaxcelt.orbit_continuation.continue_periodic_orbit`); the section is t0 = 0 (the field
+    depends on t only through the base's phase omega_pi t, so an orbit found at t0 = m T is
+    the same section). ``values[0]`` should be the orbit's own parameter value.
+    """
+    from .orbit_continuation import continue_periodic_orbit
+
+    if name not in CeltParams.__dataclass_fields__:
+        raise ValueError(f"continue_orbit: 'name' must be a CeltParams field, got {name!r}")
+    law = get_contact_law(contact_law)
+
+    def args_of(lam):
+        return eqx.tree_at(lambda p: getattr(p, name), params, jnp.asarray(lam, float))
+
+    return continue_periodic_orbit(
+        _Field(law),
+        orbit.y,
+        args_of,
+        lambda p: 2 * jnp.pi / p.omega_pi,
+        np.asarray(values, dtype=float),
+        locate=locate,
+        k=orbit.k,
+        embed=celt_embed,
+        chart=celt_chart,
+        solver=solver or diffrax.Dopri8(),
+        rtol=rtol,
+        atol=atol,
+        max_steps=max_steps,
+        newton_tol=newton_tol,
     )
