@@ -1,0 +1,297 @@
+"""Periodic orbits of the wobblestone on the vibrating base, with its Floquet multipliers.
+
+The state y (13,) = (v, omega, n, r_C, psi) lives on a manifold of dimension 8 plus two
+cyclic directions (MODEL.md section 8):
+
+* |n| = 1 and r_C3 = -rho(n) . n (the contact point on the base) fix two components;
+* v_A . n = 0 (eq. 2) fixes one more;
+* r_C1, r_C2 are cyclic: the vector field does not depend on them (translation invariance of
+  the base plane), so they are left out of the periodicity condition and their change over
+  k periods is reported as the drift;
+* psi is NOT cyclic: the base vibrates along the global X1 axis, v_pi = q omega sin(omega t) E1
+  (eq. 17) with E1 = E1(n, psi), so the field depends on psi; psi must return (mod 2 pi) too.
+
+The chart z (8,) around a reference state y_ref with normal n0 and an orthonormal pair
+e1, e2 normal to n0:
+
+    n = (n0 + z6 e1 + z7 e2) / |...|,       (inverse: z6 = n.e1 / n.n0, z7 = n.e2 / n.n0)
+    v_A = z0 e1 + z1 e2 + lam n0, lam such that v_A . n = 0   (inverse: z0 = v_A.e1, z1 = v_A.e2)
+    omega = z2:5,  psi = z5 (wrapped to y_ref's psi +- pi on the way back),
+    v = v_A - omega x rho(n),  r_C = R(n, psi)(-rho) + (X1_ref, X2_ref, 0).
+
+The 8 multipliers of d(chart o P o embed)/dz are the physical ones. The 13 x 13 state-space
+monodromy has 5 more, from the directions the chart leaves out: two exact 1s (translation of
+r_C1, r_C2) and three from the constraints |n| = 1 (1: |n| is conserved by n_dot = -w x n),
+r_C3 + rho . n (1: conserved) and v_A . n (exp(-kappa k T) with the Baumgarte gain kappa);
+they are reported as ``trivial_multipliers``.
+"""
+
+from __future__ import annotations
+
+import diffrax
+import equinox as eqx
+import jax.numpy as jnp
+import numpy as np
+
+from . import _config  # noqa: F401
+from ._types import Array, ArrayLike, Scalar
+from .contact import AbstractContactLaw, get_contact_law
+from .model import contact_geometry, horizontal_frame, vector_field
+from .params import CeltParams
+from .periodic import ORBIT_STATUS, find_periodic_orbit, sort_multipliers, stroboscopic_map
+from .state import check_state
+
+__all__ = ["CeltOrbit", "periodic_orbit", "continue_orbit", "celt_chart", "celt_embed", "ORBIT_STATUS"]
+
+
+def _basis(n0: Array) -> tuple[Array, Array]:
+    """An orthonormal pair normal to n0 (smooth away from n0 = +-e1; the contact keeps n3 > 0)."""
+    e1 = jnp.array([1.0, 0.0, 0.0], dtype=n0.dtype) - n0[0] * n0
+    e1 = e1 / jnp.linalg.norm(e1)
+    return e1, jnp.cross(n0, e1)
+
+
+def celt_embed(z: Array, y_ref: Array, params: CeltParams) -> Array:
+    """State y (13,) on the contact manifold from chart coordinates z (8,) around ``y_ref``."""
+    n0 = y_ref[6:9] / jnp.linalg.norm(y_ref[6:9])
+    e1, e2 = _basis(n0)
+    n = n0 + z[6] * e1 + z[7] * e2
+    n = n / jnp.linalg.norm(n)
+    u = z[0] * e1 + z[1] * e2
+    v_A = u - jnp.dot(u, n) / jnp.dot(n0, n) * n0
+    omega, psi = z[2:5], z[5]
+    rho = contact_geometry(n, omega, params).rho
+    v = v_A - jnp.cross(omega, rho)
+    r_C = horizontal_frame(n, psi).to_global(-rho, n)
+    # the contact point's horizontal position is taken from y_ref (cyclic coordinates)
+    x_A = horizontal_frame(y_ref[6:9], y_ref[12]).to_global(
+        -contact_geometry(y_ref[6:9], y_ref[3:6], params).rho, y_ref[6:9]
+    )
+    r_C = r_C + jnp.concatenate([y_ref[9:11] - x_A[0:2], jnp.zeros(1, z.dtype)])
+    return jnp.concatenate([v, omega, n, r_C, psi[None]])
+
+
+def celt_chart(y: Array, y_ref: Array, params: CeltParams) -> Array:
+    """Chart coordinates z (8,) = (v_A.e1, v_A.e2, omega, psi, n.e1/n.n0, n.e2/n.n0) of a state.
+
+    psi is wrapped into (psi_ref - pi, psi_ref + pi], so that a whole turn counts as periodic.
+    """
+    n0 = y_ref[6:9] / jnp.linalg.norm(y_ref[6:9])
+    e1, e2 = _basis(n0)
+    v, omega, n = y[0:3], y[3:6], y[6:9]
+    v_A = v + jnp.cross(omega, contact_geometry(n, omega, params).rho)
+    psi = y_ref[12] + jnp.remainder(y[12] - y_ref[12] + jnp.pi, 2 * jnp.pi) - jnp.pi
+    nn = jnp.dot(n, n0)
+    return jnp.concatenate(
+        [jnp.stack([jnp.dot(v_A, e1), jnp.dot(v_A, e2)]), omega, psi[None], jnp.stack([n @ e1 / nn, n @ e2 / nn])]
+    )
+
+
+class CeltOrbit(eqx.Module):
+    """A period-k orbit of the wobblestone (`periodic_orbit`); leading batch axes under vmap."""
+
+    y: Array
+    """state (13,) at the section time t0 (on the contact manifold)"""
+    k: int = eqx.field(static=True)
+    """forcing periods per return"""
+    period: Scalar
+    """k T = 2 pi k / omega_pi [s]"""
+    residual: Scalar
+    """max-norm of the periodicity defect in chart coordinates (m/s, rad/s, rad, 1)"""
+    multipliers: Array
+    """the 8 physical Floquet multipliers (complex), by decreasing modulus"""
+    trivial_multipliers: Array
+    """the 5 of the 13 x 13 monodromy from translations and constraints (see module doc)"""
+    monodromy: Array
+    """(8, 8) in chart coordinates"""
+    monodromy_full: Array
+    """(13, 13) in state coordinates"""
+    drift: Array
+    """change of the global position (r_C1, r_C2) over k periods [m]"""
+    psi_turns: Array
+    """whole turns of psi over k periods (psi(kT) - psi(0) = 2 pi psi_turns on the orbit)"""
+    status: Array
+    """`ORBIT_STATUS`: 0 converged, 1 not converged, 2 ODE solver failed"""
+    newton_steps: Array
+    ode_steps: Array
+
+    @property
+    def stable(self) -> Array:
+        """All physical multipliers strictly inside the unit circle."""
+        return jnp.all(jnp.abs(self.multipliers) < 1.0, axis=-1)
+
+    @property
+    def max_multiplier(self) -> Array:
+        """|mu| of the largest physical multiplier."""
+        return jnp.abs(self.multipliers[..., 0])
+
+    @property
+    def floquet_exponent(self) -> Array:
+        """log|mu_max| / (k T) [1/s]: the largest Lyapunov exponent of the orbit."""
+        return jnp.log(self.max_multiplier) / self.period
+
+
+class _Field(eqx.Module):
+    law: AbstractContactLaw
+
+    def __call__(self, t, y, args):
+        return vector_field(t, y, args, self.law)
+
+
+def _trivial(mu_all: Array, mu_phys: Array) -> Array:
+    """The 5 eigenvalues of the full monodromy left after removing the 8 physical ones (greedy)."""
+    rest = mu_all
+    for i in range(mu_phys.shape[0]):
+        j = jnp.argmin(jnp.abs(rest - mu_phys[i]))
+        rest = rest.at[j].set(jnp.inf)
+    keep = jnp.argsort(jnp.isinf(rest.real), stable=True)[: mu_all.shape[0] - mu_phys.shape[0]]
+    return sort_multipliers(rest[keep])
+
+
+@eqx.filter_jit
+def _orbit(params, y_guess, t0, *, k, law, solver, rtol, atol, max_steps, newton_tol, newton_max_steps):
+    T = 2 * jnp.pi / params.omega_pi
+    orb = find_periodic_orbit(
+        _Field(law),
+        y_guess,
+        params,
+        period=T,
+        k=k,
+        t0=t0,
+        embed=celt_embed,
+        chart=celt_chart,
+        solver=solver,
+        rtol=rtol,
+        atol=atol,
+        max_steps=max_steps,
+        newton_tol=newton_tol,
+        newton_max_steps=newton_max_steps,
+    )
+    # one more plain pass for the drift and psi's winding (cheap next to the variational solve)
+
+    y1, _, _ = stroboscopic_map(
+        _Field(law), orb.y, params, period=T, k=k, t0=t0, solver=solver, rtol=rtol, atol=atol, max_steps=max_steps
+    )
+    mu_all = jnp.linalg.eigvals(jnp.where(jnp.isfinite(orb.monodromy_full), orb.monodromy_full, 0.0))
+    return CeltOrbit(
+        y=orb.y,
+        k=k,
+        period=k * T,
+        residual=orb.residual,
+        multipliers=orb.multipliers,
+        trivial_multipliers=_trivial(mu_all, orb.multipliers),
+        monodromy=orb.monodromy,
+        monodromy_full=orb.monodromy_full,
+        drift=y1[9:11] - orb.y[9:11],
+        psi_turns=jnp.round((y1[12] - orb.y[12]) / (2 * jnp.pi)),
+        status=orb.status,
+        newton_steps=orb.newton_steps,
+        ode_steps=orb.ode_steps,
+    )
+
+
+def periodic_orbit(
+    params: CeltParams,
+    y_guess: ArrayLike,
+    *,
+    k: int = 1,
+    t0: float = 0.0,
+    contact_law: AbstractContactLaw | str | None = None,
+    solver: diffrax.AbstractSolver | None = None,
+    rtol: float = 1e-11,
+    atol: float = 1e-12,
+    max_steps: int = 200_000,
+    newton_tol: float = 1e-9,
+    newton_max_steps: int = 30,
+) -> CeltOrbit:
+    """Period-k orbit of the wobblestone near ``y_guess`` (a state at the section time t0).
+
+    Newton (optimistix) on the stroboscopic map over k T = 2 pi k / omega_pi in the 8 chart
+    coordinates of the contact manifold (`celt_chart`; r_C1, r_C2 excluded as cyclic, psi
+    included); Floquet multipliers from the variational equations (`jaxcelt.periodic`).
+    A good guess is the state after a long transient at t0 = m T (e.g. ``simulate`` with
+    ``ts`` on the section). Vmappable over params / guesses (jit inside; lanes that fail get
+    ``status`` 1 or 2, never an exception).
+
+    Args:
+        params: the stone and the base (omega_pi sets T).
+        y_guess: (13,) state near the orbit at time t0, on the contact manifold.
+        k: forcing periods per return (2 for a period-doubled orbit).
+        t0: section time [s] (the base's phase omega_pi t0).
+        contact_law, solver, rtol, atol, max_steps: the model's law; diffrax settings
+            (default Dopri8, rtol 1e-11, atol 1e-12).
+        newton_tol: tolerance of the periodicity defect in chart coordinates.
+        newton_max_steps: Newton iterations at most.
+    """
+    if not isinstance(params, CeltParams):
+        raise TypeError(f"params must be a CeltParams, got {type(params).__name__}")
+    if isinstance(k, bool) or not isinstance(k, int) or k < 1:
+        raise ValueError(f"periodic_orbit: 'k' must be a positive int, got {k!r}")
+    check_state(y_guess, params, name="y_guess")
+    y_guess = jnp.asarray(y_guess, dtype=float)
+    if y_guess.shape != (13,):
+        raise ValueError(f"periodic_orbit: 'y_guess' must have shape (13,), got {y_guess.shape}")
+    for name, x in (("rtol", rtol), ("atol", atol), ("newton_tol", newton_tol)):
+        if not (np.isfinite(x) and x > 0):
+            raise ValueError(f"periodic_orbit: {name!r} must be a positive finite number, got {x!r}")
+    return _orbit(
+        params,
+        y_guess,
+        jnp.asarray(t0, float),
+        k=k,
+        law=get_contact_law(contact_law),
+        solver=solver or diffrax.Dopri8(),
+        rtol=rtol,
+        atol=atol,
+        max_steps=max_steps,
+        newton_tol=newton_tol,
+        newton_max_steps=newton_max_steps,
+    )
+
+
+def continue_orbit(
+    params: CeltParams,
+    orbit: CeltOrbit,
+    name: str,
+    values: ArrayLike,
+    *,
+    contact_law: AbstractContactLaw | str | None = None,
+    solver: diffrax.AbstractSolver | None = None,
+    rtol: float = 1e-11,
+    atol: float = 1e-12,
+    max_steps: int = 200_000,
+    newton_tol: float = 1e-9,
+    locate: bool = True,
+):
+    """Follow ``orbit`` (found at ``params``) in the parameter ``name`` over ``values``.
+
+    Natural continuation with period-doubling / fold / Neimark-Sacker detection
+    (`jaxcelt.orbit_continuation.continue_periodic_orbit`); the section is t0 = 0 (the field
+    depends on t only through the base's phase omega_pi t, so an orbit found at t0 = m T is
+    the same section). ``values[0]`` should be the orbit's own parameter value.
+    """
+    from .orbit_continuation import continue_periodic_orbit
+
+    if name not in CeltParams.__dataclass_fields__:
+        raise ValueError(f"continue_orbit: 'name' must be a CeltParams field, got {name!r}")
+    law = get_contact_law(contact_law)
+
+    def args_of(lam):
+        return eqx.tree_at(lambda p: getattr(p, name), params, jnp.asarray(lam, float))
+
+    return continue_periodic_orbit(
+        _Field(law),
+        orbit.y,
+        args_of,
+        lambda p: 2 * jnp.pi / p.omega_pi,
+        np.asarray(values, dtype=float),
+        locate=locate,
+        k=orbit.k,
+        embed=celt_embed,
+        chart=celt_chart,
+        solver=solver or diffrax.Dopri8(),
+        rtol=rtol,
+        atol=atol,
+        max_steps=max_steps,
+        newton_tol=newton_tol,
+    )
