@@ -251,3 +251,67 @@ def test_pool_pilot_pause_keeps_lanes(paper_params):
     assert_same_lanes(pilot, plain, keys=("samples", "num_steps", "status", "y_final", "max_tilt"))
     np.testing.assert_allclose(pilot["first_invalid_t"], plain["first_invalid_t"], rtol=1e-9)
     np.testing.assert_allclose(pilot["min_N"], plain["min_N"], rtol=1e-7)
+
+
+QPI = np.array([0.04, 0.05])  # the paper's q_pi and a stronger forcing
+
+
+@pytest.fixture(scope="module")
+def pmap(paper_params, tmp_path_factory):
+    out = tmp_path_factory.mktemp("map") / "map"
+    return jc.parameter_map(paper_params, x=("omega_pi", VALUES), y=("q_pi", QPI), out=str(out), **KW), out
+
+
+def test_parameter_map_lanes_equal_bifurcation(pmap, base, paper_params):
+    # Every grid point is a lane of the same engine: column q_pi = 0.04 equals the base sweep,
+    # column 0.05 a bifurcation sweep with q_pi = 0.05. The map varies two parameters and mixes
+    # the lanes differently in its chunks: another compiled program, so same steps and statuses
+    # and samples within SAMPLE_ATOL (see _sweep_common), not bitwise.
+    ds, _ = pmap
+    assert ds["section"].dims == ("omega_pi", "q_pi", "sample", "state")
+    assert ds["section"].shape == (len(VALUES), len(QPI), KW["sample_periods"], 13)
+    assert ds["regime"].dims == ("omega_pi", "q_pi") and ds["lyapunov"].shape == (len(VALUES), len(QPI))
+    np.testing.assert_array_equal(ds["omega_pi"].values, VALUES)
+    np.testing.assert_array_equal(ds["q_pi"].values, QPI)
+    other = bifurcation(paper_params.replace(q_pi=float(QPI[1])), VALUES, **KW)
+    assert np.any(other.num_steps != base.num_steps)  # the second column is a different sweep
+    for j, ref in enumerate((base, other)):
+        col = {k: ds[v].isel(q_pi=j).values for k, v in (("samples", "section"), ("num_steps", "num_steps"),
+                                                         ("status", "status"))}  # fmt: skip
+        assert_same_lanes(col, {"samples": ref.samples, "num_steps": ref.num_steps, "status": ref.status})
+        # t_section is computed in the same way from omega_pi alone
+        np.testing.assert_allclose(ds["t_section"].isel(q_pi=j).values, ref.t_samples, rtol=1e-15, atol=0)
+    assert ds.attrs["x_parameter"] == "omega_pi" and ds.attrs["y_parameter"] == "q_pi"
+
+
+def test_parameter_map_resume(pmap, paper_params):
+    # the map writes chunk by chunk like a sweep: remove one chunk and the merged file, rerun:
+    # only that chunk is computed again and the dataset is identical (same program, same machine)
+    ds, out = pmap
+    os.remove(out / "chunks" / "chunk_00001.nc")
+    os.remove(out / "sweep.nc")
+    seen = []
+    again = jc.parameter_map(
+        paper_params,
+        x=("omega_pi", VALUES),
+        y=("q_pi", QPI),
+        out=str(out),
+        on_chunk=lambda ci, r: seen.append(ci),
+        **KW,
+    )
+    assert seen == [1]
+    assert again.identical(ds)
+    from jaxcelt.dataset import open_sweep
+
+    assert open_sweep(out).identical(ds)
+
+
+def test_parameter_map_bad_inputs(paper_params):
+    with pytest.raises(ValueError, match="different parameters"):
+        jc.parameter_map(paper_params, x=("mu", [0.1]), y=("mu", [0.2]))
+    with pytest.raises(ValueError, match="unknown parameter"):
+        jc.parameter_map(paper_params, x=("omega_pi", [15.0]), y=("nope", [0.2]))
+    with pytest.raises(ValueError, match="'mu'"):
+        jc.parameter_map(paper_params, x=("omega_pi", [15.0]), y=("mu", [-0.2, 0.2]))
+    with pytest.raises(ValueError, match="pair"):
+        jc.parameter_map(paper_params, x="omega_pi", y=("mu", [0.2]))
