@@ -11,7 +11,7 @@ import importlib
 import sys
 
 # Each entry is a module in jaxcelt.commands exposing register(subparsers).
-COMMANDS: tuple[str, ...] = ("simulate", "bifurcation", "fit", "ladder")
+COMMANDS: tuple[str, ...] = ("simulate", "bifurcation", "fit", "ladder", "map")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -2,6 +2,7 @@
 transparent, continuation carries states. Compared against `jaxcelt.simulate` (the core
 entry point, not written for the sweep) and against numpy recomputation of the section times."""
 
+import json
 import os
 import subprocess
 import sys
@@ -315,3 +316,57 @@ def test_parameter_map_bad_inputs(paper_params):
         jc.parameter_map(paper_params, x=("omega_pi", [15.0]), y=("mu", [-0.2, 0.2]))
     with pytest.raises(ValueError, match="pair"):
         jc.parameter_map(paper_params, x="omega_pi", y=("mu", [0.2]))
+
+
+def test_map_figure(pmap, tmp_path):
+    # the figure of a map: two panels with the parameters' axis labels (units), a regime
+    # legend naming the regimes present, and a colour bar for lambda_1 when computed
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from jaxcelt.plotting.map import map_categories, map_figure
+
+    ds, _ = pmap
+    fig = map_figure(ds)
+    axes = fig.get_axes()
+    assert axes[0].get_xlabel() == r"forcing frequency $\omega_\pi$ [rad/s]"
+    assert axes[0].get_ylabel() == r"forcing amplitude $q_\pi$ [m]"
+    cat, cats = map_categories(ds["regime"].values, ds["period"].values)
+    legend = [t.get_text() for t in axes[0].get_legend().get_texts()]
+    assert legend == [cats[i][0] for i in sorted(set(cat.ravel().tolist()))]
+    fig.savefig(tmp_path / "m.png")
+    plt.close(fig)
+    assert (tmp_path / "m.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_map_cli_rejects_bad_axis(capsys):
+    from jaxcelt.cli import main
+
+    assert main(["map", "--x", "omega_pi:10:20:3", "--out", "unused"]) == 2
+    assert "jaxcelt map: error: --x expects NAME=START:STOP:COUNT" in capsys.readouterr().out
+    assert main(["map", "--y", "q_pi=-0.1:0.1:3", "--x", "omega_pi=15", "--out", "unused"]) == 2
+    assert "'q_pi'" in capsys.readouterr().out
+
+
+@pytest.mark.slow
+def test_map_cli_equals_api(tmp_path, paper_params):
+    # `jaxcelt map` writes the dataset of jc.parameter_map with the same settings (1e-10: the CLI
+    # runs on --host-devices 1 here but the compiled program may still differ, see _sweep_common),
+    # plus summary.json and the figure
+    from jaxcelt.dataset import open_sweep
+
+    out = tmp_path / "m"
+    cmd = [sys.executable, "-m", "jaxcelt", "map", "--x", "omega_pi=14,17", "--y", "q_pi=0.04,0.05", "--transient",
+           "1", "--sample", "2", "--lyapunov", "0", "--host-devices", "1", "--out", str(out)]  # fmt: skip
+    subprocess.run(cmd, check=True, capture_output=True)
+    ds = open_sweep(out)
+    ref = jc.parameter_map(paper_params, x=("omega_pi", [14.0, 17.0]), y=("q_pi", [0.04, 0.05]), transient_periods=1,
+                           sample_periods=2, stop_on_invalid=True)  # fmt: skip
+    a = {"samples": ds["section"].values, "num_steps": ds["num_steps"].values, "status": ds["status"].values}
+    b = {"samples": ref["section"].values, "num_steps": ref["num_steps"].values, "status": ref["status"].values}
+    assert_same_lanes(a, b)
+    s = json.loads((out / "summary.json").read_text())
+    assert s["cells"] == 4 and sum(s["regime_counts"].values()) == 4
+    assert (out / "map.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
