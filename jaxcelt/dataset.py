@@ -331,12 +331,12 @@ def _durable_replace(tmp: Path, path: Path) -> None:
 
 
 def _atomic_write_dataset(ds: xr.Dataset, path: Path) -> None:
-    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp = path.with_suffix(f"{path.suffix}.tmp{os.getpid()}")  # processes of one sweep may race
     ds.to_netcdf(tmp, engine=_ENGINE)
     _durable_replace(tmp, path)
 
 
 def _atomic_write_text(path: Path, text: str) -> None:
-    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp = path.with_suffix(f"{path.suffix}.tmp{os.getpid()}")
     tmp.write_text(text)
     _durable_replace(tmp, path)

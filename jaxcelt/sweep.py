@@ -58,15 +58,19 @@ Execution model
   1-device run to ~1e-11 over a few periods (tests), not bitwise (a different compiled
   program): over hundreds of periods chaotic lanes diverge from that seed like any other.
 
-Multi-host (several machines, each with local accelerators)
------------------------------------------------------------
-Call ``jax.distributed.initialize(coordinator_address, num_processes, process_id)`` at the
-start of each process, then give each process its own share of the parameter values, e.g.
-``values[jax.process_index()::jax.process_count()]``, and call `bifurcation` there: it
-shards over that process's *local* devices only, so hosts never wait for each other. Write
-each process's dataset to its own directory (``out=f"run/host{jax.process_index()}"``) and
-concatenate them with `jaxcelt.dataset.open_sweep` + ``xarray.concat`` afterwards. Lanes
-are independent, so this is embarrassingly parallel and gives the same numbers as one host.
+Multi-host (several processes or machines, each with local devices)
+-------------------------------------------------------------------
+Call ``jax.distributed.initialize(...)`` at the start of every process (on SLURM, with no
+arguments: it reads the job's environment), then make the *same* call -- `sweep`,
+`bifurcation` or `parameter_map` with the same ``out``, a directory all processes share --
+in every process. Process i computes the chunks whose index is i mod ``jax.process_count()``
+(each over its *local* devices; hosts never wait for each other inside a chunk) and writes
+them to ``out/chunks``; after a barrier (`jax.experimental.multihost_utils.sync_global_devices`)
+process 0 reads them all back, writes ``out/sweep.nc`` and returns the result; the other
+processes return None. A chunk is the same computation whichever process runs it, so the
+dataset equals a one-process run's (to the rounding of another compiled program if the
+processes have other device counts; tested with 2 processes on one machine). An interrupted
+multi-process sweep resumes like any other, with any number of processes.
 
 Continuation
 ------------
@@ -1011,6 +1015,36 @@ def _run_chunked(
     return merged
 
 
+def _run_all(
+    pb_all: CeltParams,
+    lane_y0: np.ndarray,
+    cfg: SweepConfig,
+    chunks: list[np.ndarray],
+    pad_to: int,
+    writer: Any,
+    done: dict[int, dict[str, np.ndarray]],
+    **kwargs,
+) -> dict[str, np.ndarray] | None:
+    """`_run_chunked`, split over the processes of a `jax.distributed` run when there are several.
+
+    Process i computes the chunks with index = i (mod process count) and writes them into the
+    shared ``out`` directory; after a barrier (`multihost_utils.sync_global_devices`) process 0
+    reads every chunk back (recomputing any that is missing or damaged) and returns the lanes;
+    the other processes return None."""
+    pc, pi = jax.process_count(), jax.process_index()
+    if pc == 1:
+        return _run_chunked(pb_all, lane_y0, cfg, chunks, pad_to, writer, done, **kwargs)
+    if writer is None:
+        raise ValueError("a sweep over several processes (jax.distributed) needs out= (a directory they all share)")
+    from jax.experimental import multihost_utils
+
+    _run_chunked(pb_all, lane_y0, cfg, chunks, pad_to, writer, done, skip=lambda ci: ci % pc != pi, **kwargs)
+    multihost_utils.sync_global_devices(f"jaxcelt sweep {writer.fingerprint[:16]}: chunks written")
+    if pi != 0:
+        return None
+    return _run_chunked(pb_all, lane_y0, cfg, chunks, pad_to, writer, writer.load_done(), **kwargs)
+
+
 def sweep(
     params: CeltParams,
     name: str,
@@ -1061,12 +1095,14 @@ def sweep(
         width: batch slots per device of the pool (default `DEFAULT_WIDTH`).
         devices: devices to shard each chunk over (default all local devices).
         out: directory; write the dataset chunk by chunk there and resume a previous,
-            interrupted run of the same sweep (`jaxcelt.dataset`).
+            interrupted run of the same sweep (`jaxcelt.dataset`). Required when several
+            processes run the sweep together (`jax.distributed`; see the module docstring).
         progress: tqdm bar over lanes (with ETA).
         on_chunk: ``on_chunk(chunk_index, chunk_results)`` called after each chunk.
 
     Returns:
         `SweepResult` with lane arrays reshaped to (L_v, K, ...) when y0 has K starts, else (L_v, ...).
+        In a multi-process run (`jax.distributed`), process 0 returns it and the others None.
     """
     cfg = _sweep_config(
         transient_periods, sample_periods, lyapunov_periods, rtol, atol, max_steps, solver, contact_law, t0,
@@ -1113,11 +1149,13 @@ def sweep(
         )
         done = writer.load_done()
 
-    lanes = _run_chunked(
+    lanes = _run_all(
         pb_all, lane_y0, cfg, chunks, cs, writer, done,
         devices=devices, scheduler=scheduler, width=width, varying=(name,),
         progress=progress, desc=f"sweep {name}", on_chunk=on_chunk,
     )  # fmt: skip
+    if lanes is None:  # a process other than 0 of a multi-process sweep: its chunks are on disk
+        return None
     merged = {k: v.reshape((Lv, K, *v.shape[1:])) if multi else v for k, v in lanes.items()}
     vals = lane_values.reshape(Lv, K) if multi else lane_values
     result = SweepResult(name=name, values=vals, **merged)
@@ -1206,7 +1244,8 @@ def parameter_map(
         a sweep dataset (`jaxcelt.dataset`: section samples, status, validity, ``lyapunov``
         [1/s] if ``lyapunov_periods > 0``, NaN otherwise) and the regime labels ``regime``,
         ``period``, ``global_motion`` (`jaxcelt.regimes`). With ``out`` it is also written to
-        ``out/sweep.nc``.
+        ``out/sweep.nc``. In a multi-process run (`jax.distributed`), process 0 returns it and
+        the others None.
     """
     cfg = _sweep_config(
         transient_periods, sample_periods, lyapunov_periods, rtol, atol, max_steps, solver, contact_law, t0,
@@ -1257,11 +1296,13 @@ def parameter_map(
             chunks=chunks,
         )
         done = writer.load_done()
-    lanes = _run_chunked(
+    lanes = _run_all(
         pb_all, lane_y0, cfg, chunks, cs, writer, done,
         devices=devices, scheduler=scheduler, width=width, varying=(xn, yn),
         progress=progress, desc=f"map {xn} x {yn}", on_chunk=on_chunk,
     )  # fmt: skip
+    if lanes is None:  # a process other than 0 of a multi-process map
+        return None
     from .dataset import to_map_dataset
 
     shape = (nx, ny, K) if multi else (nx, ny)

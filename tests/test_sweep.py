@@ -370,3 +370,67 @@ def test_map_cli_equals_api(tmp_path, paper_params):
     s = json.loads((out / "summary.json").read_text())
     assert s["cells"] == 4 and sum(s["regime_counts"].values()) == 4
     assert (out / "map.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+_TWO_PROCESS = """
+import sys
+import jax
+jax.config.update("jax_num_cpu_devices", 1)
+jax.distributed.initialize(coordinator_address=sys.argv[1], num_processes=2, process_id=int(sys.argv[2]))
+import numpy as np
+import jaxcelt as jc
+values = np.array([12.0, 14.0, 17.0, 19.0, 12.5, 14.5, 17.5, 19.5])
+kw = dict(transient_periods=3, sample_periods=4, rtol=1e-8, atol=1e-10, max_steps=4000, chunk_size=4)
+seen = []
+r = jc.bifurcation(jc.CeltParams.paper(), values, out=sys.argv[3], on_chunk=lambda ci, res: seen.append(ci), **kw)
+print("PROCESS", jax.process_index(), jax.process_count(), "CHUNKS", seen, "RESULT", r is not None, flush=True)
+"""
+
+
+@pytest.mark.slow
+def test_two_processes_equal_one(paper_params, tmp_path):
+    # A sweep run by 2 processes joined with jax.distributed (localhost, CPU): process i computes
+    # the chunks i mod 2 into the shared directory, process 0 assembles the dataset after a
+    # barrier. It must equal a one-process sweep of the same lanes: same steps and statuses,
+    # samples within SAMPLE_ATOL (the processes compile their own programs; see _sweep_common).
+    import socket
+
+    from jaxcelt.dataset import open_sweep
+
+    with socket.socket() as s:
+        s.bind(("localhost", 0))
+        port = s.getsockname()[1]
+    out = tmp_path / "shared"
+    env = dict(os.environ, JAXCELT_CACHE_DIR="off")
+    env.pop("XLA_FLAGS", None)
+    procs = [
+        subprocess.Popen(
+            [sys.executable, "-c", _TWO_PROCESS, f"localhost:{port}", str(i), str(out)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=env,
+        )  # fmt: skip
+        for i in range(2)
+    ]
+    outs = [p.communicate(timeout=600) for p in procs]
+    for p, (_, e) in zip(procs, outs):
+        assert p.returncode == 0, e[-3000:]
+    lines = [[s for s in o.splitlines() if s.startswith("PROCESS")][0] for o, _ in outs]
+    assert lines[0] == "PROCESS 0 2 CHUNKS [0] RESULT True", lines
+    assert lines[1] == "PROCESS 1 2 CHUNKS [1] RESULT False", lines
+    ds = open_sweep(out)
+    values = np.concatenate([VALUES, VALUES + 0.5])
+    np.testing.assert_array_equal(ds["omega_pi"].values, values)
+    one = bifurcation(paper_params, values, **KW)
+    got = {"samples": ds["section"].values, "num_steps": ds["num_steps"].values, "status": ds["status"].values}
+    assert_same_lanes(got, {"samples": one.samples, "num_steps": one.num_steps, "status": one.status})
+    np.testing.assert_array_equal(ds["regime"].values, open_sweep_regimes(one, paper_params))
+
+
+def open_sweep_regimes(result, params):
+    from jaxcelt.dataset import to_dataset
+    from jaxcelt.sweep import SweepConfig
+
+    cfg = SweepConfig(**{k: v for k, v in KW.items() if k != "chunk_size"})
+    return to_dataset(result, params, cfg)["regime"].values
