@@ -20,7 +20,7 @@ from .noslip import simulate_noslip
 from .params import PARAM_NAMES, CeltParams
 from .solve import INVALID_KINDS, STATUS, Solution, simulate
 from .state import check_state, constraint_residual, initial_state
-from .sweep import SweepResult, bifurcation, continuation
+from .sweep import SweepResult, bifurcation, continuation, parameter_map
 
 __version__ = "0.1.0"
 
@@ -41,6 +41,7 @@ __all__ = [
     "bifurcation",
     "celt_lyapunov",
     "continuation",
+    "parameter_map",
     "largest_lyapunov",
     "CONTACT_LAWS",
     "CeltParams",

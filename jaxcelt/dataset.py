@@ -4,12 +4,16 @@ Layout of an output directory ``out/``::
 
     out/manifest.json          what is being computed (fingerprint of params, values, y0,
                                solver settings, chunking) -- a resume must match it
-    out/chunks/chunk_00000.nc  one netCDF file per finished chunk (atomic: temp file + rename)
+    out/chunks/chunk_00000.nc  one netCDF file per finished chunk (atomic: temp file, fsync,
+                               rename, fsync of the directory)
     out/sweep.nc               the merged dataset, written when every chunk is done
 
 An interrupted sweep (killed process, power cut) is resumed by calling the same
 `jaxcelt.sweep`/`bifurcation` with the same ``out``: finished chunks are read back, the
-missing ones computed. Every chunk is a deterministic function of its lanes, and float64
+missing ones computed. A chunk file is used only if it opens, belongs to this sweep (its
+fingerprint), holds this chunk's lanes (their indices) and every expected variable with the
+expected shape; a damaged one (torn write, bad copy, a file of another sweep or version) is
+recomputed with a `warnings.warn` (`DamagedChunkWarning`) instead of failing the resume. Every chunk is a deterministic function of its lanes, and float64
 round-trips netCDF exactly, so the final dataset is identical to an uninterrupted run's.
 
 The merged dataset has dimensions ``(<param>, [start,] sample, state)`` and variables
@@ -26,6 +30,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -36,10 +41,15 @@ from .model import STATE_NAMES
 from .params import CeltParams
 from .regimes import GLOBAL_MOTION, REGIMES, classify
 
-__all__ = ["SweepWriter", "to_dataset", "open_sweep", "SWEEP_FILE"]
+__all__ = ["SweepWriter", "to_dataset", "to_map_dataset", "open_sweep", "SWEEP_FILE", "DamagedChunkWarning"]
 
 SWEEP_FILE = "sweep.nc"
 _ENGINE = "h5netcdf"
+
+
+class DamagedChunkWarning(RuntimeWarning):
+    """A chunk file of an interrupted sweep could not be used on resume; the chunk is recomputed."""
+
 
 _LANE_DIMS: dict[str, tuple[str, ...]] = {
     "t_samples": ("sample",),
@@ -109,37 +119,72 @@ def _attrs(params: CeltParams, name: str, config: Any, n_starts: int) -> dict[st
     }
 
 
+def _lane_variables(fields: dict[str, Any], lead: tuple[str, ...], **classify_kwargs) -> dict[str, xr.Variable]:
+    """Dataset variables (and regime labels) from lane arrays with leading dims ``lead``."""
+    from .sweep import _LANE_FIELDS
+
+    data = {}
+    for key in _LANE_FIELDS:
+        if key == "values":
+            continue
+        arr = np.asarray(fields[key])
+        if arr.dtype == bool:
+            arr = arr.astype(np.int8)
+        out = _RENAME.get(key, key)
+        desc, units = _DOCS[out]
+        data[out] = xr.Variable(lead + _LANE_DIMS.get(key, ()), arr, attrs={"long_name": desc, "units": units})
+    f = fields
+    labels = classify(f["samples"], f["status"], f["valid"], f["r_O"], f["lyapunov"], **classify_kwargs)
+    for key, arr in labels.items():
+        desc, units = _DOCS[key]
+        data[key] = xr.Variable(lead, arr, attrs={"long_name": desc, "units": units})
+    return data
+
+
+def _base_coords(n_samples: int) -> dict[str, Any]:
+    return {"state": list(STATE_NAMES), "xyz": ["X1", "X2", "X3"], "sample": np.arange(n_samples)}
+
+
 def to_dataset(result: Any, params: CeltParams, config: Any, **classify_kwargs) -> xr.Dataset:
     """An xarray Dataset from a `jaxcelt.sweep.SweepResult` (regime labels added)."""
     name = result.name
     vals = np.asarray(result.values)
     multi = vals.ndim == 2
     lead = (name, "start") if multi else (name,)
-    coords: dict[str, Any] = {
-        name: vals[:, 0] if multi else vals,
-        "state": list(STATE_NAMES),
-        "xyz": ["X1", "X2", "X3"],
-    }
+    coords: dict[str, Any] = {name: vals[:, 0] if multi else vals, **_base_coords(np.shape(result.samples)[-2])}
     if multi:
         coords["start"] = np.arange(vals.shape[1])
-    coords["sample"] = np.arange(np.shape(result.samples)[-2])
-    data = {}
     from .sweep import _LANE_FIELDS
 
-    for key in _LANE_FIELDS:
-        if key == "values":
-            continue
-        arr = np.asarray(getattr(result, key))
-        if arr.dtype == bool:
-            arr = arr.astype(np.int8)
-        out = _RENAME.get(key, key)
-        desc, units = _DOCS[out]
-        data[out] = xr.Variable(lead + _LANE_DIMS.get(key, ()), arr, attrs={"long_name": desc, "units": units})
-    labels = classify(result.samples, result.status, result.valid, result.r_O, result.lyapunov, **classify_kwargs)
-    for key, arr in labels.items():
-        desc, units = _DOCS[key]
-        data[key] = xr.Variable(lead, arr, attrs={"long_name": desc, "units": units})
+    fields = {k: getattr(result, k) for k in _LANE_FIELDS}
+    data = _lane_variables(fields, lead, **classify_kwargs)
     attrs = _attrs(params, name, config, vals.shape[1] if multi else 1)
+    attrs["classify_json"] = json.dumps(classify_kwargs, sort_keys=True)
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def to_map_dataset(
+    lanes: dict[str, np.ndarray],
+    *,
+    x: tuple[str, np.ndarray],
+    y: tuple[str, np.ndarray],
+    n_starts: int,
+    params: CeltParams,
+    config: Any,
+    **classify_kwargs,
+) -> xr.Dataset:
+    """A two-parameter map's Dataset, dims ``(x, y, [start,] ...)``, from lane arrays shaped
+    (nx, ny, [K,] ...) (``n_starts`` = K, 0 for a single start without a ``start`` dim)."""
+    (xn, xs), (yn, ys) = x, y
+    lead = (xn, yn, "start") if n_starts else (xn, yn)
+    coords: dict[str, Any] = {xn: np.asarray(xs), yn: np.asarray(ys), **_base_coords(lanes["samples"].shape[-2])}
+    if n_starts:
+        coords["start"] = np.arange(n_starts)
+    data = _lane_variables(lanes, lead, **classify_kwargs)
+    attrs = _attrs(params, f"{xn} x {yn}", config, max(n_starts, 1))
+    attrs.pop("swept_parameter")
+    attrs["title"] = f"jaxcelt two-parameter map over {xn} x {yn}"
+    attrs["x_parameter"], attrs["y_parameter"] = xn, yn
     attrs["classify_json"] = json.dumps(classify_kwargs, sort_keys=True)
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
@@ -173,8 +218,13 @@ class SweepWriter:
         manifest["fingerprint"] = self.fingerprint
         (self.dir / "chunks").mkdir(parents=True, exist_ok=True)
         mpath = self.dir / "manifest.json"
+        old = None
         if mpath.exists():
-            old = json.loads(mpath.read_text())
+            try:
+                old = json.loads(mpath.read_text())
+            except (ValueError, OSError) as e:  # torn manifest: the chunk files carry the fingerprint too
+                warnings.warn(f"{mpath} is damaged ({e}); rewriting it", DamagedChunkWarning, stacklevel=3)
+        if old is not None:
             if old.get("fingerprint") != self.fingerprint:
                 raise ValueError(
                     f"{self.dir} holds a different sweep (manifest fingerprint differs); use a new directory or delete it"
@@ -186,44 +236,107 @@ class SweepWriter:
         return self.dir / "chunks" / f"chunk_{ci:05d}.nc"
 
     def write_chunk(self, ci: int, res: dict[str, np.ndarray]) -> None:
-        data = {}
+        data = {"lane_index": xr.Variable(("lane",), np.asarray(self.chunks[ci], dtype=np.int64))}
         for key, arr in res.items():
             arr = np.asarray(arr)
             if arr.dtype == bool:
                 arr = arr.astype(np.int8)
             data[key] = xr.Variable(("lane",) + tuple(f"{key}_{i}" for i in range(1, arr.ndim)), arr)
         ds = xr.Dataset(data, attrs={"fingerprint": self.fingerprint, "chunk": ci})
-        path = self._chunk_path(ci)
-        tmp = path.with_suffix(".nc.tmp")
-        ds.to_netcdf(tmp, engine=_ENGINE)
-        os.replace(tmp, path)
+        _atomic_write_dataset(ds, self._chunk_path(ci))
+
+    def _read_chunk(self, ci: int, path: Path) -> dict[str, np.ndarray]:
+        """A chunk file's lane arrays; ValueError saying why it cannot be used."""
+        try:
+            with xr.open_dataset(path, engine=_ENGINE) as ds:
+                attrs = dict(ds.attrs)
+                res = {k: ds[k].values for k in ds.data_vars}  # reads every byte: a torn file fails here
+        except Exception as e:  # h5py/h5netcdf raise OSError, KeyError, ValueError... on damaged files
+            raise ValueError(f"unreadable ({type(e).__name__}: {str(e)[:120]})") from None
+        if attrs.get("fingerprint") != self.fingerprint:
+            raise ValueError("written by another sweep or version (fingerprint differs)")
+        if int(attrs.get("chunk", -1)) != ci:
+            raise ValueError(f"holds chunk {attrs.get('chunk')!r}, not {ci}")
+        lanes = np.asarray(self.chunks[ci])
+        if not np.array_equal(res.pop("lane_index", None), lanes):
+            raise ValueError("does not hold this chunk's lanes")
+        S = int(self.config.sample_periods)
+        shapes = {k: (len(lanes),) for k in _CHUNK_SCALARS}
+        shapes.update(samples=(len(lanes), S, 13), t_samples=(len(lanes), S), r_O=(len(lanes), S, 3))
+        shapes["y_final"] = (len(lanes), 13)
+        for key, shape in shapes.items():
+            if key not in res:
+                raise ValueError(f"variable {key!r} missing")
+            if res[key].shape != shape:
+                raise ValueError(f"variable {key!r} has shape {res[key].shape}, expected {shape}")
+        res["valid"] = res["valid"].astype(bool)
+        return res
 
     def load_done(self) -> dict[int, dict[str, np.ndarray]]:
+        """The finished chunks on disk; damaged ones are left out (recomputed) with a warning."""
         done = {}
         for ci in range(len(self.chunks)):
             path = self._chunk_path(ci)
             if not path.exists():
                 continue
-            with xr.open_dataset(path, engine=_ENGINE) as ds:
-                if ds.attrs.get("fingerprint") != self.fingerprint:
-                    continue
-                res = {k: ds[k].values for k in ds.data_vars}
-            for k in ("valid",):
-                if k in res:
-                    res[k] = res[k].astype(bool)
-            done[ci] = res
+            try:
+                done[ci] = self._read_chunk(ci, path)
+            except ValueError as e:
+                warnings.warn(f"chunk file {path} is damaged, recomputing it: {e}", DamagedChunkWarning, stacklevel=3)
         return done
 
     def finalize(self, result: Any) -> xr.Dataset:
-        ds = to_dataset(result, self.params, self.config)
-        path = self.dir / SWEEP_FILE
-        tmp = path.with_suffix(".nc.tmp")
-        ds.to_netcdf(tmp, engine=_ENGINE)
-        os.replace(tmp, path)
+        return self.write_dataset(to_dataset(result, self.params, self.config))
+
+    def write_dataset(self, ds: xr.Dataset) -> xr.Dataset:
+        """Write the merged dataset (``out/sweep.nc``)."""
+        _atomic_write_dataset(ds, self.dir / SWEEP_FILE)
         return ds
 
 
-def _atomic_write_text(path: Path, text: str) -> None:
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(text)
+_CHUNK_SCALARS = (
+    "status",
+    "valid",
+    "first_invalid_t",
+    "first_invalid_kind",
+    "min_N",
+    "max_tilt",
+    "drift",
+    "max_excursion",
+    "num_steps",
+    "lyapunov",
+)
+"""per-lane scalars every chunk file holds (besides samples, t_samples, r_O, y_final)"""
+
+
+def _fsync_dir(path: Path) -> None:
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:  # platforms without directory handles (Windows)
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _durable_replace(tmp: Path, path: Path) -> None:
+    """Flush ``tmp`` to disk, rename it onto ``path`` (atomic), flush the directory entry."""
+    with open(tmp, "rb+") as f:
+        os.fsync(f.fileno())
     os.replace(tmp, path)
+    _fsync_dir(path.parent)
+
+
+def _atomic_write_dataset(ds: xr.Dataset, path: Path) -> None:
+    tmp = path.with_suffix(f"{path.suffix}.tmp{os.getpid()}")  # processes of one sweep may race
+    ds.to_netcdf(tmp, engine=_ENGINE)
+    _durable_replace(tmp, path)
+
+
+def _atomic_write_text(path: Path, text: str) -> None:
+    tmp = path.with_suffix(f"{path.suffix}.tmp{os.getpid()}")
+    tmp.write_text(text)
+    _durable_replace(tmp, path)

@@ -58,15 +58,19 @@ Execution model
   1-device run to ~1e-11 over a few periods (tests), not bitwise (a different compiled
   program): over hundreds of periods chaotic lanes diverge from that seed like any other.
 
-Multi-host (several machines, each with local accelerators)
------------------------------------------------------------
-Call ``jax.distributed.initialize(coordinator_address, num_processes, process_id)`` at the
-start of each process, then give each process its own share of the parameter values, e.g.
-``values[jax.process_index()::jax.process_count()]``, and call `bifurcation` there: it
-shards over that process's *local* devices only, so hosts never wait for each other. Write
-each process's dataset to its own directory (``out=f"run/host{jax.process_index()}"``) and
-concatenate them with `jaxcelt.dataset.open_sweep` + ``xarray.concat`` afterwards. Lanes
-are independent, so this is embarrassingly parallel and gives the same numbers as one host.
+Multi-host (several processes or machines, each with local devices)
+-------------------------------------------------------------------
+Call ``jax.distributed.initialize(...)`` at the start of every process (on SLURM, with no
+arguments: it reads the job's environment), then make the *same* call -- `sweep`,
+`bifurcation` or `parameter_map` with the same ``out``, a directory all processes share --
+in every process. Process i computes the chunks whose index is i mod ``jax.process_count()``
+(each over its *local* devices; hosts never wait for each other inside a chunk) and writes
+them to ``out/chunks``; after a barrier (`jax.experimental.multihost_utils.sync_global_devices`)
+process 0 reads them all back, writes ``out/sweep.nc`` and returns the result; the other
+processes return None. A chunk is the same computation whichever process runs it, so the
+dataset equals a one-process run's (to the rounding of another compiled program if the
+processes have other device counts; tested with 2 processes on one machine). An interrupted
+multi-process sweep resumes like any other, with any number of processes.
 
 Continuation
 ------------
@@ -112,6 +116,7 @@ __all__ = [
     "parse_range",
     "orbit",
     "run_lanes",
+    "parameter_map",
 ]
 
 
@@ -932,6 +937,114 @@ def _broadcast_y0(params: CeltParams, y0: Any, n_values: int) -> np.ndarray:
     return np.ascontiguousarray(y)
 
 
+def _sweep_config(
+    transient_periods, sample_periods, lyapunov_periods, rtol, atol, max_steps, solver, contact_law, t0, stop_on_invalid
+) -> SweepConfig:
+    return SweepConfig(
+        transient_periods=int(transient_periods),
+        sample_periods=int(sample_periods),
+        lyapunov_periods=int(lyapunov_periods),
+        rtol=float(rtol),
+        atol=float(atol),
+        max_steps=int(max_steps),
+        solver=solver if solver is not None else DEFAULT_SOLVER,
+        contact_law=contact_law,
+        t0=float(t0),
+        stop_on_invalid=bool(stop_on_invalid),
+    )
+
+
+def _run_chunked(
+    pb_all: CeltParams,
+    lane_y0: np.ndarray,
+    cfg: SweepConfig,
+    chunks: list[np.ndarray],
+    pad_to: int,
+    writer: Any,
+    done: dict[int, dict[str, np.ndarray]],
+    *,
+    devices: Sequence[Any] | None,
+    scheduler: str,
+    width: int | None,
+    varying: Sequence[str],
+    progress: bool,
+    desc: str,
+    on_chunk: Callable[[int, dict[str, np.ndarray]], None] | None,
+    skip: Callable[[int], bool] = lambda ci: False,
+) -> dict[str, np.ndarray] | None:
+    """Run the chunks of lanes not in ``done`` (each written by ``writer`` if given) and return
+    every lane's results in lane order, (L, ...) per field of `SweepResult` but ``values``.
+
+    ``skip(ci)``: chunks left to another process (multi-process sweeps); if any chunk is
+    neither done nor computed here, returns None."""
+    L = lane_y0.shape[0]
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=L, unit="lane", desc=desc, initial=sum(len(chunks[i]) for i in done))
+    results: dict[int, dict[str, np.ndarray]] = dict(done)
+    for ci, idx in enumerate(chunks):
+        if ci in results or skip(ci):
+            continue
+        pb = jax.tree_util.tree_map(lambda x, idx=idx: np.asarray(x)[idx], pb_all)
+        t_start = time.perf_counter()
+        res = run_lanes(
+            pb, lane_y0[idx], cfg, devices=devices, pad_to=pad_to, scheduler=scheduler, width=width, varying=varying
+        )
+        res["_seconds"] = np.full(len(idx), (time.perf_counter() - t_start) / len(idx))
+        results[ci] = res
+        if writer is not None:
+            writer.write_chunk(ci, res)
+        if on_chunk is not None:
+            on_chunk(ci, res)
+        if bar is not None:
+            bar.update(len(idx))
+    if bar is not None:
+        bar.close()
+    if len(results) < len(chunks):
+        return None
+    merged: dict[str, np.ndarray] = {}
+    for key in _LANE_FIELDS:
+        if key == "values":
+            continue
+        cat = np.concatenate([results[ci][key] for ci in range(len(chunks))], axis=0)
+        full = np.empty_like(cat)
+        full[np.concatenate(chunks)] = cat
+        merged[key] = full
+    return merged
+
+
+def _run_all(
+    pb_all: CeltParams,
+    lane_y0: np.ndarray,
+    cfg: SweepConfig,
+    chunks: list[np.ndarray],
+    pad_to: int,
+    writer: Any,
+    done: dict[int, dict[str, np.ndarray]],
+    **kwargs,
+) -> dict[str, np.ndarray] | None:
+    """`_run_chunked`, split over the processes of a `jax.distributed` run when there are several.
+
+    Process i computes the chunks with index = i (mod process count) and writes them into the
+    shared ``out`` directory; after a barrier (`multihost_utils.sync_global_devices`) process 0
+    reads every chunk back (recomputing any that is missing or damaged) and returns the lanes;
+    the other processes return None."""
+    pc, pi = jax.process_count(), jax.process_index()
+    if pc == 1:
+        return _run_chunked(pb_all, lane_y0, cfg, chunks, pad_to, writer, done, **kwargs)
+    if writer is None:
+        raise ValueError("a sweep over several processes (jax.distributed) needs out= (a directory they all share)")
+    from jax.experimental import multihost_utils
+
+    _run_chunked(pb_all, lane_y0, cfg, chunks, pad_to, writer, done, skip=lambda ci: ci % pc != pi, **kwargs)
+    multihost_utils.sync_global_devices(f"jaxcelt sweep {writer.fingerprint[:16]}: chunks written")
+    if pi != 0:
+        return None
+    return _run_chunked(pb_all, lane_y0, cfg, chunks, pad_to, writer, writer.load_done(), **kwargs)
+
+
 def sweep(
     params: CeltParams,
     name: str,
@@ -982,25 +1095,19 @@ def sweep(
         width: batch slots per device of the pool (default `DEFAULT_WIDTH`).
         devices: devices to shard each chunk over (default all local devices).
         out: directory; write the dataset chunk by chunk there and resume a previous,
-            interrupted run of the same sweep (`jaxcelt.dataset`).
+            interrupted run of the same sweep (`jaxcelt.dataset`). Required when several
+            processes run the sweep together (`jax.distributed`; see the module docstring).
         progress: tqdm bar over lanes (with ETA).
         on_chunk: ``on_chunk(chunk_index, chunk_results)`` called after each chunk.
 
     Returns:
         `SweepResult` with lane arrays reshaped to (L_v, K, ...) when y0 has K starts, else (L_v, ...).
+        In a multi-process run (`jax.distributed`), process 0 returns it and the others None.
     """
-    cfg = SweepConfig(
-        transient_periods=int(transient_periods),
-        sample_periods=int(sample_periods),
-        lyapunov_periods=int(lyapunov_periods),
-        rtol=float(rtol),
-        atol=float(atol),
-        max_steps=int(max_steps),
-        solver=solver if solver is not None else DEFAULT_SOLVER,
-        contact_law=contact_law,
-        t0=float(t0),
-        stop_on_invalid=bool(stop_on_invalid),
-    )
+    cfg = _sweep_config(
+        transient_periods, sample_periods, lyapunov_periods, rtol, atol, max_steps, solver, contact_law, t0,
+        stop_on_invalid,
+    )  # fmt: skip
     if scheduler not in SCHEDULERS:
         raise ValueError(f"scheduler must be one of {SCHEDULERS}, got {scheduler!r}")
     values = np.atleast_1d(np.asarray(values, dtype=np.float64))
@@ -1042,40 +1149,14 @@ def sweep(
         )
         done = writer.load_done()
 
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=L, unit="lane", desc=f"sweep {name}", initial=sum(len(chunks[i]) for i in done))
-    results: dict[int, dict[str, np.ndarray]] = dict(done)
-    for ci, idx in enumerate(chunks):
-        if ci in results:
-            continue
-        pb = jax.tree_util.tree_map(lambda x, idx=idx: np.asarray(x)[idx], pb_all)
-        t_start = time.perf_counter()
-        res = run_lanes(
-            pb, lane_y0[idx], cfg, devices=devices, pad_to=cs, scheduler=scheduler, width=width, varying=(name,)
-        )
-        res["_seconds"] = np.full(len(idx), (time.perf_counter() - t_start) / len(idx))
-        results[ci] = res
-        if writer is not None:
-            writer.write_chunk(ci, res)
-        if on_chunk is not None:
-            on_chunk(ci, res)
-        if bar is not None:
-            bar.update(len(idx))
-    if bar is not None:
-        bar.close()
-
-    merged: dict[str, np.ndarray] = {}
-    for key in _LANE_FIELDS:
-        if key == "values":
-            continue
-        parts = [results[ci][key] for ci in range(len(chunks))]
-        cat = np.concatenate(parts, axis=0)
-        full = np.empty_like(cat)
-        full[np.concatenate(chunks)] = cat
-        merged[key] = full.reshape((Lv, K, *full.shape[1:])) if multi else full
+    lanes = _run_all(
+        pb_all, lane_y0, cfg, chunks, cs, writer, done,
+        devices=devices, scheduler=scheduler, width=width, varying=(name,),
+        progress=progress, desc=f"sweep {name}", on_chunk=on_chunk,
+    )  # fmt: skip
+    if lanes is None:  # a process other than 0 of a multi-process sweep: its chunks are on disk
+        return None
+    merged = {k: v.reshape((Lv, K, *v.shape[1:])) if multi else v for k, v in lanes.items()}
     vals = lane_values.reshape(Lv, K) if multi else lane_values
     result = SweepResult(name=name, values=vals, **merged)
     if writer is not None:
@@ -1106,6 +1187,130 @@ def bifurcation(
         y0=y0,
         **kwargs,
     )
+
+
+def _checked_values(name: str, values: Any, params: CeltParams) -> np.ndarray:
+    if name not in PARAM_NAMES:
+        raise ValueError(f"unknown parameter {name!r}; known: {PARAM_NAMES}")
+    v = np.atleast_1d(np.asarray(values, dtype=np.float64))
+    if v.ndim != 1 or v.size == 0:
+        raise ValueError(f"values of {name!r} must be a non-empty 1-D array, got shape {v.shape}")
+    if not np.all(np.isfinite(v)):
+        raise ValueError(f"values of {name!r} must be finite")
+    return v
+
+
+def parameter_map(
+    params: CeltParams,
+    x: tuple[str, Any],
+    y: tuple[str, Any],
+    *,
+    transient_periods: int = 200,
+    sample_periods: int = 100,
+    y0: Any = None,
+    lyapunov_periods: int = 0,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    max_steps: int = 1_000_000,
+    solver: diffrax.AbstractSolver | None = None,
+    contact_law: AbstractContactLaw | str | None = None,
+    t0: float = 0.0,
+    chunk_size: int | None = None,
+    sort_by_cost: bool = False,
+    stop_on_invalid: bool = False,
+    scheduler: str = "pool",
+    width: int | None = None,
+    devices: Sequence[Any] | None = None,
+    out: str | None = None,
+    progress: bool = False,
+    on_chunk: Callable[[int, dict[str, np.ndarray]], None] | None = None,
+) -> Any:
+    """Two-parameter chart (regimes, Lyapunov exponent) over a grid of two `CeltParams` fields.
+
+    Every grid point (x_i, y_j) (and every start) is one lane of the same engine as `sweep`:
+    the same stroboscopic sampling, pool, chunked resumable writing (``out``) and sharding,
+    so a lane equals the `bifurcation`/`sweep` lane with the same parameters (to the rounding
+    of another compiled program, see the module docstring).
+
+    Args:
+        params: base parameters.
+        x, y: ``(name, values)``: a `CeltParams` field and its 1-D values, e.g.
+            ``("omega_pi", np.linspace(10, 20, 100))``, ``("q_pi", np.linspace(0.02, 0.06, 60))``.
+        y0: None (at rest), (13,) or (K, 13) starts (every grid point from each).
+        other arguments: as `sweep` (``sort_by_cost`` orders lanes by 1/omega_pi).
+
+    Returns:
+        `xarray.Dataset` with dims ``(x_name, y_name, [start,] sample, state)``: the variables of
+        a sweep dataset (`jaxcelt.dataset`: section samples, status, validity, ``lyapunov``
+        [1/s] if ``lyapunov_periods > 0``, NaN otherwise) and the regime labels ``regime``,
+        ``period``, ``global_motion`` (`jaxcelt.regimes`). With ``out`` it is also written to
+        ``out/sweep.nc``. In a multi-process run (`jax.distributed`), process 0 returns it and
+        the others None.
+    """
+    cfg = _sweep_config(
+        transient_periods, sample_periods, lyapunov_periods, rtol, atol, max_steps, solver, contact_law, t0,
+        stop_on_invalid,
+    )  # fmt: skip
+    if scheduler not in SCHEDULERS:
+        raise ValueError(f"scheduler must be one of {SCHEDULERS}, got {scheduler!r}")
+    for arg, spec in (("x", x), ("y", y)):
+        if not (isinstance(spec, tuple | list) and len(spec) == 2 and isinstance(spec[0], str)):
+            raise ValueError(f"{arg} must be a (parameter name, values) pair, got {spec!r}")
+    (xn, xv), (yn, yv) = x, y
+    if xn == yn:
+        raise ValueError(f"x and y must be different parameters, both are {xn!r}")
+    xs, ys = _checked_values(xn, xv, params), _checked_values(yn, yv, params)
+    for a in (xs.min(), xs.max()):  # validates the grid's corners (ValueError naming the field)
+        for b in (ys.min(), ys.max()):
+            params.replace(**{xn: a, yn: b})
+    multi = y0 is not None and np.ndim(y0) >= 2
+    y0v = _broadcast_y0(params, y0, 1)[0]  # (K, 13)
+    K = y0v.shape[0]
+    nx, ny = len(xs), len(ys)
+    L = nx * ny * K
+    lane_x = np.repeat(xs, ny * K)
+    lane_y = np.tile(np.repeat(ys, K), nx)
+    lane_y0 = np.ascontiguousarray(np.tile(y0v, (nx * ny, 1)))
+    pb_all = lanes_params(params, xn, lane_x)
+    pb_all = eqx.tree_at(lambda p: getattr(p, yn), pb_all, jnp.asarray(lane_y))
+    if not np.all(np.asarray(pb_all.omega_pi) > 0):
+        raise ValueError("stroboscopic sampling needs omega_pi > 0 in every lane")
+    order = np.arange(L)
+    if sort_by_cost:
+        order = np.argsort(np.asarray(pb_all.omega_pi), kind="stable")  # longest period first
+    cs = L if chunk_size is None else max(1, min(int(chunk_size), L))
+    chunks = [order[i : i + cs] for i in range(0, L, cs)]
+    writer = None
+    done: dict[int, dict[str, np.ndarray]] = {}
+    if out is not None:
+        from .dataset import SweepWriter
+
+        writer = SweepWriter(
+            out,
+            params=params,
+            name=[xn, yn],
+            lane_values=np.stack([lane_x, lane_y], axis=1),
+            lane_y0=lane_y0,
+            n_starts=K,
+            config=cfg,
+            chunks=chunks,
+        )
+        done = writer.load_done()
+    lanes = _run_all(
+        pb_all, lane_y0, cfg, chunks, cs, writer, done,
+        devices=devices, scheduler=scheduler, width=width, varying=(xn, yn),
+        progress=progress, desc=f"map {xn} x {yn}", on_chunk=on_chunk,
+    )  # fmt: skip
+    if lanes is None:  # a process other than 0 of a multi-process map
+        return None
+    from .dataset import to_map_dataset
+
+    shape = (nx, ny, K) if multi else (nx, ny)
+    lanes = {k: v.reshape(shape + v.shape[1:]) for k, v in lanes.items()}
+    ds = to_map_dataset(lanes, x=(xn, xs), y=(yn, ys), n_starts=K if multi else 0, params=params, config=cfg)
+    if writer is not None:
+        writer.write_dataset(ds)
+    return ds
 
 
 def continuation(

@@ -13,7 +13,7 @@ import pytest
 import xarray as xr
 from _sweep_common import KW, VALUES
 
-from jaxcelt.dataset import open_sweep
+from jaxcelt.dataset import DamagedChunkWarning, open_sweep
 from jaxcelt.sweep import bifurcation
 
 VALUES8 = np.concatenate([VALUES, VALUES + 0.5])  # 2 chunks of the shared chunk shape (4 lanes)
@@ -51,10 +51,79 @@ def test_resume_identical(tmp_path, paper_params):
     assert open_sweep(part).identical(ds_full)
 
 
+def _damage(path, how):
+    """Damage a chunk file as a torn write (first half of its bytes) or a bad copy (garbage)."""
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2] if how == "truncate" else os.urandom(len(data)))
+
+
+def test_resume_recomputes_damaged_chunks(tmp_path, paper_params):
+    # One chunk file truncated to half its bytes, another overwritten with random bytes, a third
+    # from another sweep (a valid netCDF file whose fingerprint differs): the resume must warn
+    # about each and recompute it, and end with the dataset of an uninterrupted run. Same machine,
+    # same compiled program (the shared chunk shape) -> bitwise identical, as in the test above.
+    values = np.concatenate([VALUES8, VALUES + 0.25])  # 3 chunks of 4 lanes
+    full = tmp_path / "full"
+    bifurcation(paper_params, values, out=str(full), **KW)
+    part = tmp_path / "part"
+    bifurcation(paper_params, values, out=str(part), **KW)
+    other = tmp_path / "other"
+    bifurcation(paper_params, values + 0.125, out=str(other), **KW)
+    os.remove(part / "sweep.nc")
+    chunks = part / "chunks"
+    _damage(chunks / "chunk_00000.nc", "truncate")
+    _damage(chunks / "chunk_00001.nc", "garbage")
+    (chunks / "chunk_00002.nc").write_bytes((other / "chunks" / "chunk_00002.nc").read_bytes())
+    seen = []
+    with pytest.warns(DamagedChunkWarning) as rec:
+        bifurcation(paper_params, values, out=str(part), on_chunk=lambda ci, r: seen.append(ci), **KW)
+    msgs = [str(w.message) for w in rec if issubclass(w.category, DamagedChunkWarning)]
+    assert len(msgs) == 3, msgs
+    assert "chunk_00000.nc" in msgs[0] and "unreadable" in msgs[0]
+    assert "chunk_00001.nc" in msgs[1] and "unreadable" in msgs[1]
+    assert "chunk_00002.nc" in msgs[2] and "fingerprint" in msgs[2]
+    assert seen == [0, 1, 2]
+    assert open_sweep(part).identical(open_sweep(full))
+
+
 def test_refuses_other_sweep(tmp_path, paper_params):
     bifurcation(paper_params, VALUES, out=str(tmp_path), **KW)
     with pytest.raises(ValueError, match="different sweep"):
         bifurcation(paper_params, VALUES + 1, out=str(tmp_path), **KW)
+
+
+def _run_until_chunks(cmd, out, n_min=1):
+    """Start the CLI, SIGKILL it once ``n_min`` chunk files exist; returns their paths."""
+    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    t0 = time.time()
+    while len(list((out / "chunks").glob("chunk_*.nc")) if (out / "chunks").exists() else []) < n_min:
+        assert time.time() - t0 < 300 and p.poll() is None
+        time.sleep(0.2)
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    return sorted((out / "chunks").glob("chunk_*.nc"))
+
+
+@pytest.mark.slow
+def test_killed_truncated_and_resumed(tmp_path):
+    # An interrupted CLI sweep whose chunk file is then truncated (a torn write or a bad copy):
+    # the rerun prints one warning line, recomputes that chunk and writes the dataset of an
+    # uninterrupted run (same machine and program: identical).
+    out = tmp_path / "run"
+    cmd = [sys.executable, "-m", "jaxcelt", "bifurcation", "--omega", "12:19:8", "--transient", "3", "--sample", "4",
+           "--lyapunov", "0", "--max-steps", "4000", "--chunk-size", "2", "--orbits", "", "--no-figures",
+           "--out", str(out)]  # fmt: skip
+    files = _run_until_chunks(cmd, out)
+    assert not (out / "sweep.nc").exists() and len(files) < 4
+    _damage(files[0], "truncate")
+    rerun = subprocess.run(cmd, check=True, capture_output=True, text=True)
+    warn = [s for s in rerun.stdout.splitlines() if "warning" in s]
+    assert len(warn) == 1 and warn[0].startswith("jaxcelt bifurcation: warning: chunk file"), rerun.stdout[-2000:]
+    assert files[0].name in warn[0]
+    assert "Traceback" not in rerun.stderr
+    ref = tmp_path / "ref"
+    subprocess.run(cmd[:-1] + [str(ref)], check=True, capture_output=True)
+    assert open_sweep(out).identical(open_sweep(ref))
 
 
 @pytest.mark.slow

@@ -2,6 +2,7 @@
 transparent, continuation carries states. Compared against `jaxcelt.simulate` (the core
 entry point, not written for the sweep) and against numpy recomputation of the section times."""
 
+import json
 import os
 import subprocess
 import sys
@@ -251,3 +252,185 @@ def test_pool_pilot_pause_keeps_lanes(paper_params):
     assert_same_lanes(pilot, plain, keys=("samples", "num_steps", "status", "y_final", "max_tilt"))
     np.testing.assert_allclose(pilot["first_invalid_t"], plain["first_invalid_t"], rtol=1e-9)
     np.testing.assert_allclose(pilot["min_N"], plain["min_N"], rtol=1e-7)
+
+
+QPI = np.array([0.04, 0.05])  # the paper's q_pi and a stronger forcing
+
+
+@pytest.fixture(scope="module")
+def pmap(paper_params, tmp_path_factory):
+    out = tmp_path_factory.mktemp("map") / "map"
+    return jc.parameter_map(paper_params, x=("omega_pi", VALUES), y=("q_pi", QPI), out=str(out), **KW), out
+
+
+def test_parameter_map_lanes_equal_bifurcation(pmap, base, paper_params):
+    # Every grid point is a lane of the same engine: column q_pi = 0.04 equals the base sweep,
+    # column 0.05 a bifurcation sweep with q_pi = 0.05. The map varies two parameters and mixes
+    # the lanes differently in its chunks: another compiled program, so same steps and statuses
+    # and samples within SAMPLE_ATOL (see _sweep_common), not bitwise.
+    ds, _ = pmap
+    assert ds["section"].dims == ("omega_pi", "q_pi", "sample", "state")
+    assert ds["section"].shape == (len(VALUES), len(QPI), KW["sample_periods"], 13)
+    assert ds["regime"].dims == ("omega_pi", "q_pi") and ds["lyapunov"].shape == (len(VALUES), len(QPI))
+    np.testing.assert_array_equal(ds["omega_pi"].values, VALUES)
+    np.testing.assert_array_equal(ds["q_pi"].values, QPI)
+    other = bifurcation(paper_params.replace(q_pi=float(QPI[1])), VALUES, **KW)
+    assert np.any(other.num_steps != base.num_steps)  # the second column is a different sweep
+    for j, ref in enumerate((base, other)):
+        col = {k: ds[v].isel(q_pi=j).values for k, v in (("samples", "section"), ("num_steps", "num_steps"),
+                                                         ("status", "status"))}  # fmt: skip
+        assert_same_lanes(col, {"samples": ref.samples, "num_steps": ref.num_steps, "status": ref.status})
+        # t_section is computed in the same way from omega_pi alone
+        np.testing.assert_allclose(ds["t_section"].isel(q_pi=j).values, ref.t_samples, rtol=1e-15, atol=0)
+    assert ds.attrs["x_parameter"] == "omega_pi" and ds.attrs["y_parameter"] == "q_pi"
+
+
+def test_parameter_map_resume(pmap, paper_params):
+    # the map writes chunk by chunk like a sweep: remove one chunk and the merged file, rerun:
+    # only that chunk is computed again and the dataset is identical (same program, same machine)
+    ds, out = pmap
+    os.remove(out / "chunks" / "chunk_00001.nc")
+    os.remove(out / "sweep.nc")
+    seen = []
+    again = jc.parameter_map(
+        paper_params,
+        x=("omega_pi", VALUES),
+        y=("q_pi", QPI),
+        out=str(out),
+        on_chunk=lambda ci, r: seen.append(ci),
+        **KW,
+    )
+    assert seen == [1]
+    assert again.identical(ds)
+    from jaxcelt.dataset import open_sweep
+
+    assert open_sweep(out).identical(ds)
+
+
+def test_parameter_map_bad_inputs(paper_params):
+    with pytest.raises(ValueError, match="different parameters"):
+        jc.parameter_map(paper_params, x=("mu", [0.1]), y=("mu", [0.2]))
+    with pytest.raises(ValueError, match="unknown parameter"):
+        jc.parameter_map(paper_params, x=("omega_pi", [15.0]), y=("nope", [0.2]))
+    with pytest.raises(ValueError, match="'mu'"):
+        jc.parameter_map(paper_params, x=("omega_pi", [15.0]), y=("mu", [-0.2, 0.2]))
+    with pytest.raises(ValueError, match="pair"):
+        jc.parameter_map(paper_params, x="omega_pi", y=("mu", [0.2]))
+
+
+def test_map_figure(pmap, tmp_path):
+    # the figure of a map: two panels with the parameters' axis labels (units), a regime
+    # legend naming the regimes present, and a colour bar for lambda_1 when computed
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from jaxcelt.plotting.map import map_categories, map_figure
+
+    ds, _ = pmap
+    fig = map_figure(ds)
+    axes = fig.get_axes()
+    assert axes[0].get_xlabel() == r"forcing frequency $\omega_\pi$ [rad/s]"
+    assert axes[0].get_ylabel() == r"forcing amplitude $q_\pi$ [m]"
+    cat, cats = map_categories(ds["regime"].values, ds["period"].values)
+    legend = [t.get_text() for t in axes[0].get_legend().get_texts()]
+    assert legend == [cats[i][0] for i in sorted(set(cat.ravel().tolist()))]
+    fig.savefig(tmp_path / "m.png")
+    plt.close(fig)
+    assert (tmp_path / "m.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_map_cli_rejects_bad_axis(capsys):
+    from jaxcelt.cli import main
+
+    assert main(["map", "--x", "omega_pi:10:20:3", "--out", "unused"]) == 2
+    assert "jaxcelt map: error: --x expects NAME=START:STOP:COUNT" in capsys.readouterr().out
+    assert main(["map", "--y", "q_pi=-0.1:0.1:3", "--x", "omega_pi=15", "--out", "unused"]) == 2
+    assert "'q_pi'" in capsys.readouterr().out
+
+
+@pytest.mark.slow
+def test_map_cli_equals_api(tmp_path, paper_params):
+    # `jaxcelt map` writes the dataset of jc.parameter_map with the same settings (1e-10: the CLI
+    # runs on --host-devices 1 here but the compiled program may still differ, see _sweep_common),
+    # plus summary.json and the figure
+    from jaxcelt.dataset import open_sweep
+
+    out = tmp_path / "m"
+    cmd = [sys.executable, "-m", "jaxcelt", "map", "--x", "omega_pi=14,17", "--y", "q_pi=0.04,0.05", "--transient",
+           "1", "--sample", "2", "--lyapunov", "0", "--host-devices", "1", "--out", str(out)]  # fmt: skip
+    subprocess.run(cmd, check=True, capture_output=True)
+    ds = open_sweep(out)
+    ref = jc.parameter_map(paper_params, x=("omega_pi", [14.0, 17.0]), y=("q_pi", [0.04, 0.05]), transient_periods=1,
+                           sample_periods=2, stop_on_invalid=True)  # fmt: skip
+    a = {"samples": ds["section"].values, "num_steps": ds["num_steps"].values, "status": ds["status"].values}
+    b = {"samples": ref["section"].values, "num_steps": ref["num_steps"].values, "status": ref["status"].values}
+    assert_same_lanes(a, b)
+    s = json.loads((out / "summary.json").read_text())
+    assert s["cells"] == 4 and sum(s["regime_counts"].values()) == 4
+    assert (out / "map.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+_TWO_PROCESS = """
+import sys
+import jax
+jax.config.update("jax_num_cpu_devices", 1)
+jax.distributed.initialize(coordinator_address=sys.argv[1], num_processes=2, process_id=int(sys.argv[2]))
+import numpy as np
+import jaxcelt as jc
+values = np.array([12.0, 14.0, 17.0, 19.0, 12.5, 14.5, 17.5, 19.5])
+kw = dict(transient_periods=3, sample_periods=4, rtol=1e-8, atol=1e-10, max_steps=4000, chunk_size=4)
+seen = []
+r = jc.bifurcation(jc.CeltParams.paper(), values, out=sys.argv[3], on_chunk=lambda ci, res: seen.append(ci), **kw)
+print("PROCESS", jax.process_index(), jax.process_count(), "CHUNKS", seen, "RESULT", r is not None, flush=True)
+"""
+
+
+@pytest.mark.slow
+def test_two_processes_equal_one(paper_params, tmp_path):
+    # A sweep run by 2 processes joined with jax.distributed (localhost, CPU): process i computes
+    # the chunks i mod 2 into the shared directory, process 0 assembles the dataset after a
+    # barrier. It must equal a one-process sweep of the same lanes: same steps and statuses,
+    # samples within SAMPLE_ATOL (the processes compile their own programs; see _sweep_common).
+    import socket
+
+    from jaxcelt.dataset import open_sweep
+
+    with socket.socket() as s:
+        s.bind(("localhost", 0))
+        port = s.getsockname()[1]
+    out = tmp_path / "shared"
+    env = dict(os.environ, JAXCELT_CACHE_DIR="off")
+    env.pop("XLA_FLAGS", None)
+    procs = [
+        subprocess.Popen(
+            [sys.executable, "-c", _TWO_PROCESS, f"localhost:{port}", str(i), str(out)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=env,
+        )  # fmt: skip
+        for i in range(2)
+    ]
+    outs = [p.communicate(timeout=600) for p in procs]
+    for p, (_, e) in zip(procs, outs):
+        assert p.returncode == 0, e[-3000:]
+    lines = [[s for s in o.splitlines() if s.startswith("PROCESS")][0] for o, _ in outs]
+    assert lines[0] == "PROCESS 0 2 CHUNKS [0] RESULT True", lines
+    assert lines[1] == "PROCESS 1 2 CHUNKS [1] RESULT False", lines
+    ds = open_sweep(out)
+    values = np.concatenate([VALUES, VALUES + 0.5])
+    np.testing.assert_array_equal(ds["omega_pi"].values, values)
+    one = bifurcation(paper_params, values, **KW)
+    got = {"samples": ds["section"].values, "num_steps": ds["num_steps"].values, "status": ds["status"].values}
+    assert_same_lanes(got, {"samples": one.samples, "num_steps": one.num_steps, "status": one.status})
+    np.testing.assert_array_equal(ds["regime"].values, open_sweep_regimes(one, paper_params))
+
+
+def open_sweep_regimes(result, params):
+    from jaxcelt.dataset import to_dataset
+    from jaxcelt.sweep import SweepConfig
+
+    cfg = SweepConfig(**{k: v for k, v in KW.items() if k != "chunk_size"})
+    return to_dataset(result, params, cfg)["regime"].values

@@ -230,6 +230,7 @@ def run(args) -> int:
 
     import jaxcelt as jc
     from jaxcelt.benchmarking import make_solver
+    from jaxcelt.commands._warnings import one_line_warnings
     from jaxcelt.dataset import open_sweep
     from jaxcelt.sweep import DEFAULT_WIDTH, sweep
     from jaxcelt.versions import versions_string
@@ -254,25 +255,26 @@ def run(args) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     solver = make_solver(args.solver)
     t0 = time.perf_counter()
-    sweep(
-        params,
-        args.param,
-        values,
-        transient_periods=args.transient,
-        sample_periods=args.sample,
-        lyapunov_periods=args.lyapunov,
-        y0=y0,
-        solver=solver,
-        rtol=args.rtol,
-        atol=args.atol,
-        max_steps=args.max_steps,
-        chunk_size=args.chunk_size,
-        width=args.width,
-        stop_on_invalid=args.stop_on_invalid,
-        sort_by_cost=True,
-        out=str(args.out),
-        progress=True,
-    )
+    with one_line_warnings("bifurcation"):  # e.g. a damaged chunk file recomputed on resume
+        sweep(
+            params,
+            args.param,
+            values,
+            transient_periods=args.transient,
+            sample_periods=args.sample,
+            lyapunov_periods=args.lyapunov,
+            y0=y0,
+            solver=solver,
+            rtol=args.rtol,
+            atol=args.atol,
+            max_steps=args.max_steps,
+            chunk_size=args.chunk_size,
+            width=args.width,
+            stop_on_invalid=args.stop_on_invalid,
+            sort_by_cost=True,
+            out=str(args.out),
+            progress=True,
+        )
     wall = time.perf_counter() - t0
     ds = open_sweep(args.out)
     summary = {

@@ -1,0 +1,167 @@
+"""``jaxcelt map``: a two-parameter regime / Lyapunov chart -> dataset (netCDF) + figure (PNG) + summary (JSON).
+
+Every grid point is one lane of the sweep engine (stroboscopic sampling after a transient, regime
+labels, optional largest Lyapunov exponent). Interrupting and rerunning the same command resumes
+from the finished chunks. Example (the paper's forcing plane)::
+
+    jaxcelt map --x omega_pi=10:20:100 --y q_pi=0.02:0.06:60 --out out/map
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import time
+from pathlib import Path
+
+from .args import UsageError, floats, nonnegative_int, override, overrides, positive_float, positive_int, value_range
+from .bifurcation import SWEEP_SOLVERS, _set_host_devices
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "map",
+        help="two-parameter map of regimes and the largest Lyapunov exponent (e.g. omega_pi x q_pi)",
+        description=__doc__.splitlines()[0],
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+    )
+    p.add_argument("--x", default="omega_pi=10:20:40", metavar="NAME=RANGE",
+                   help="horizontal axis: a CeltParams field and its values, START:STOP:COUNT or a,b,c")  # fmt: skip
+    p.add_argument("--y", default="q_pi=0.02:0.06:24", metavar="NAME=RANGE", help="vertical axis, as --x")
+    p.add_argument("--transient", type=nonnegative_int, default=100, help="transient forcing periods discarded")
+    p.add_argument("--sample", type=positive_int, default=30, help="stroboscopic samples (periods) kept")
+    p.add_argument(
+        "--lyapunov", type=nonnegative_int, default=30, help="periods of tangent dynamics for lambda_1 (0: off)"
+    )
+    p.add_argument("--set", action="append", type=override, default=[], metavar="NAME=VALUE",
+                   help="override any other CeltParams field, repeatable")  # fmt: skip
+    p.add_argument("--omega0", type=floats(3), default="0,0,0", help="initial omega (body) [rad/s]")
+    p.add_argument("--solver", default="Tsit5", choices=SWEEP_SOLVERS, help="explicit Runge-Kutta method")
+    p.add_argument("--rtol", type=positive_float, default=1e-8)
+    p.add_argument("--atol", type=positive_float, default=1e-10)
+    p.add_argument("--max-steps", type=positive_int, default=1_000_000)
+    p.add_argument(
+        "--chunk-size", type=positive_int, default=600, help="lanes per jitted pool launch (unit of resumable writing)"
+    )
+    p.add_argument(
+        "--width", type=positive_int, default=None, help="pool slots per device (default jaxcelt.sweep.DEFAULT_WIDTH)"
+    )
+    p.add_argument("--host-devices", default="auto",
+                   help="CPU only: split the CPU into this many JAX devices ('auto' = cores, 1 = off)")  # fmt: skip
+    p.add_argument("--stop-on-invalid", action=argparse.BooleanOptionalAction, default=True,
+                   help="end a lane at its first invalid state (lift-off or n3 <= 0): label 'invalid'")  # fmt: skip
+    p.add_argument("--out", type=Path, default=Path("out/map"), help="output directory (resumable)")
+    p.add_argument("--no-figures", action="store_true")
+    p.set_defaults(func=run)
+
+
+def parse_axis(spec: str, flag: str):
+    """``"omega_pi=10:20:100"`` -> ("omega_pi", values); `UsageError` (a ValueError) naming the flag otherwise."""
+    if "=" not in spec:
+        raise UsageError(f"argument {flag}: expected NAME=START:STOP:COUNT (or NAME=a,b,c), got {spec!r}")
+    name, rng = (s.strip() for s in spec.split("=", 1))
+    try:
+        values = value_range(rng)
+    except argparse.ArgumentTypeError as e:
+        raise UsageError(f"argument {flag}: {e}") from None
+    if values.size == 0:
+        raise UsageError(f"argument {flag}: no values in {rng!r}")
+    return name, values
+
+
+def summarize(ds) -> dict:
+    """Counts of each regime category and the Lyapunov range (for summary.json)."""
+    import numpy as np
+
+    from jaxcelt.plotting.map import map_categories
+
+    sel = {"start": 0} if "start" in ds.dims else {}
+    d = ds.isel(**sel)
+    cat, cats = map_categories(d["regime"].values, d["period"].values)
+    counts = {label: int(np.sum(cat == i)) for i, (label, _) in enumerate(cats) if np.any(cat == i)}
+    lam = d["lyapunov"].values
+    fin = np.isfinite(lam)
+    out = {
+        "cells": int(cat.size),
+        "regime_counts": counts,
+        "unbounded_wandering_cells": int(np.sum(d["global_motion"].values == 1)),
+        "lyapunov_cells": int(fin.sum()),
+    }
+    if fin.any():
+        out["lyapunov_per_s"] = {
+            "min": round(float(lam[fin].min()), 4),
+            "median": round(float(np.median(lam[fin])), 4),
+            "max": round(float(lam[fin].max()), 4),
+            "positive_above_0.02": int(np.sum(lam[fin] > 0.02)),
+        }
+    return out
+
+
+def run(args) -> int:
+    _set_host_devices(args.host_devices)
+    import jax
+    import numpy as np
+
+    import jaxcelt as jc
+    from jaxcelt.benchmarking import make_solver
+    from jaxcelt.commands._warnings import one_line_warnings
+    from jaxcelt.sweep import DEFAULT_WIDTH
+    from jaxcelt.versions import versions_string
+
+    # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2), before any work
+    x = parse_axis(args.x, "--x")
+    y = parse_axis(args.y, "--y")
+    params = jc.CeltParams.paper(**overrides(args.set))
+    for name in (x[0], y[0]):
+        if name not in jc.PARAM_NAMES:
+            raise UsageError(f"argument --x/--y: unknown parameter {name!r}; known: {', '.join(jc.PARAM_NAMES)}")
+    for name, values in (x, y):  # each lane's parameters must be valid too
+        for v in values:
+            params.replace(**{name: float(v)})
+    y0 = np.asarray(jc.initial_state(params, omega=args.omega0))
+    print(versions_string(), flush=True)
+    load = os.getloadavg() if hasattr(os, "getloadavg") else None
+    t0 = time.perf_counter()
+    with one_line_warnings("map"):
+        ds = jc.parameter_map(
+            params, x=x, y=y, y0=y0, transient_periods=args.transient, sample_periods=args.sample,
+            lyapunov_periods=args.lyapunov, solver=make_solver(args.solver), rtol=args.rtol, atol=args.atol,
+            max_steps=args.max_steps, chunk_size=args.chunk_size, width=args.width,
+            stop_on_invalid=args.stop_on_invalid, sort_by_cost=True, out=str(args.out), progress=True,
+        )  # fmt: skip
+    wall = time.perf_counter() - t0
+    summary = {
+        "command": "jaxcelt map",
+        "x": {"name": x[0], "from": float(x[1][0]), "to": float(x[1][-1]), "n": int(x[1].size)},
+        "y": {"name": y[0], "from": float(y[1][0]), "to": float(y[1][-1]), "n": int(y[1].size)},
+        "set": args.set,
+        "transient_periods": args.transient,
+        "sample_periods": args.sample,
+        "lyapunov_periods": args.lyapunov,
+        "solver": args.solver,
+        "rtol": args.rtol,
+        "atol": args.atol,
+        "stop_on_invalid": bool(args.stop_on_invalid),
+        "devices": [str(d) for d in jax.local_devices()],
+        "chunk_size": args.chunk_size,
+        "width_per_device": args.width or DEFAULT_WIDTH,
+        "wall_seconds_including_compile": round(wall, 2),
+        "load_average_at_start": None if load is None else [round(v, 2) for v in load],
+        **summarize(ds),
+    }
+    (args.out / "summary.json").write_text(json.dumps(summary, indent=1))
+    print(json.dumps(summary, indent=1), flush=True)
+    if not args.no_figures:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        from jaxcelt.plotting.map import map_figure
+
+        fig = map_figure(ds, title=f"{x[0]} x {y[0]} map: {args.transient} transient + {args.sample} sampled periods")
+        fig.savefig(args.out / "map.png", dpi=150)
+        plt.close(fig)
+    print(f"wrote {args.out}", flush=True)
+    return 0

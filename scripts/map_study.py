@@ -1,0 +1,47 @@
+"""The omega_pi x q_pi regime / Lyapunov map of docs/map/: runs ``jaxcelt map`` (100 x 60 grid by
+default) and copies its figure and summary (with the machine's load average before and after)
+into docs/map/. Resumable: rerunning continues an interrupted run in --out.
+
+    python scripts/map_study.py [--out out/map_100x60] [--docs docs/map]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ARGS = ["--x", "omega_pi=10:20:100", "--y", "q_pi=0.02:0.06:60", "--transient", "100", "--sample", "30",
+        "--lyapunov", "30"]  # fmt: skip
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, default=Path("out/map_100x60"))
+    ap.add_argument("--docs", type=Path, default=Path("docs/map"))
+    a = ap.parse_args()
+    load_before = os.getloadavg()
+    cmd = [sys.executable, "-m", "jaxcelt", "map", *ARGS, "--out", str(a.out)]
+    t0 = time.perf_counter()
+    subprocess.run(cmd, check=True)
+    wall = time.perf_counter() - t0
+    load_after = os.getloadavg()
+    summary = json.loads((a.out / "summary.json").read_text())
+    summary["whole_command_seconds"] = round(wall, 1)
+    summary["load_average_before_after"] = [list(map(float, load_before)), list(map(float, load_after))]
+    summary["cpu_count"] = os.cpu_count()
+    summary["argv"] = ["jaxcelt", "map", *ARGS]
+    a.docs.mkdir(parents=True, exist_ok=True)
+    (a.docs / "map_omega_q_100x60.json").write_text(json.dumps(summary, indent=1) + "\n")
+    shutil.copyfile(a.out / "map.png", a.docs / "map_omega_q_100x60.png")
+    print(f"wrote {a.docs}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
