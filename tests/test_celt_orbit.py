@@ -67,3 +67,22 @@ def test_period_one_orbit_at_15_6_against_scipy_fd_and_lyapunov():
     assert r["lyapunov_rel_diff"] < 0.02, r
     np.testing.assert_allclose(r["trivial_multipliers_abs"], 1.0, atol=1e-6)
     assert np.max(np.abs(r["drift_m"])) < 1e-8
+
+
+@pytest.mark.slow
+def test_continue_orbit_in_omega_pi_is_smooth():
+    # a short step of the 15.6 rad/s orbit in omega_pi: every point converges, multipliers move
+    # continuously (|mu| changes < 0.05 per 0.05 rad/s) and nothing crosses the unit circle
+    spec = importlib.util.spec_from_file_location("orbit_check", ROOT / "scripts" / "orbit_check.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    p = jc.CeltParams.paper(omega_pi=15.6)
+    yg, t0 = mod.guess(p)
+    orb = jc.periodic_orbit(p, yg, t0=t0)
+    br = jc.continue_orbit(p, orb, "omega_pi", [15.6, 15.65, 15.7])
+    assert br.stopped_at is None and len(br.values) == 3
+    np.testing.assert_allclose(np.abs(br.multipliers[0]), np.abs(np.asarray(orb.multipliers)), atol=1e-8)
+    assert np.max(np.abs(np.diff(np.abs(br.multipliers), axis=0))) < 0.05
+    assert br.bifurcations == [] and bool(np.all(br.stable))
+    with pytest.raises(ValueError, match="'name'"):
+        jc.continue_orbit(p, orb, "nope", [15.6])
