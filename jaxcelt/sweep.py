@@ -1128,7 +1128,7 @@ def continuation(
             attractors show as differing branches.
         y0: None, (13,) or (K, 13): K starts continued side by side (vmapped).
         other arguments: as `sweep` (``t0`` is 0 for every step; the final state of a step
-        sits at a section time, base phase 0, so the restart is phase consistent).
+            sits at a section time, base phase 0, so the restart is phase consistent).
 
     Returns:
         ``{"up": SweepResult, "down": SweepResult}`` (the requested directions), values in
