@@ -1,7 +1,7 @@
 """Speed-against-accuracy analysis: test scenes, reference solutions, timed solver runs.
 
 The building blocks of ``benchmarks/{reference,work_precision,stability,peers}.py`` and of
-``notebooks/05_speed_accuracy.ipynb`` (issue 7). Nothing here is physics: every trajectory comes
+``notebooks/05_speed_accuracy.ipynb``. Nothing here is physics: every trajectory comes
 from `jaxcelt.simulate` (or from a peer integrator calling the same right-hand side).
 
 * `Scene` / `make_scene`: named test problems (from rest at omega_pi = 14, 17, 19; a fixed-table
