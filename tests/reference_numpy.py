@@ -262,5 +262,3 @@ def pieces(t: float, y: np.ndarray, p: dict) -> dict:
     c = contact_quantities(t, y, p)
     short = dict(vsx="v_sx", vsy="v_sy", ws="omega_s", dc="d_c", ds="d_s", Tsx="T_sx", Tsy="T_sy", Ms="M_s")
     return {**c, **{k: c[v] for k, v in short.items()}}
-
-
