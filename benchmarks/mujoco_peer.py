@@ -1,4 +1,4 @@
-"""MuJoCo (C) and MJX peers (issue 7): the same stone as an ellipsoid on a plane, condim 6.
+"""MuJoCo (C) and MJX peers: the same stone as an ellipsoid on a plane, condim 6.
 
 A *different contact model*: MuJoCo resolves a single soft contact point per step (convex
 collision, soft constraint with solref/solimp, elliptic friction cone with sliding, torsional and

@@ -1,4 +1,4 @@
-"""jaxcelt against the integrators people would otherwise use (issue 7), same scene, same accuracy.
+"""jaxcelt against the integrators people would otherwise use, same scene, same accuracy.
 
 Single trajectory (scene rest17 from rest, error at the stroboscopic samples against the Dopri8
 1e-13 reference): jaxcelt (diffrax Tsit5 / Dopri8 / Kvaerno5-Newton, jit-compiled), scipy

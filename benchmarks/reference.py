@@ -1,4 +1,4 @@
-"""Reference-solution protocol (issue 7): two different integrators at tolerance <= 1e-13 must agree.
+"""Reference-solution protocol: two different integrators at tolerance <= 1e-13 must agree.
 
 For each scene (`jaxcelt.benchmarking.make_scene`) and horizon:
 

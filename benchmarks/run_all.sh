@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Reproduce the speed/accuracy study (issue 7): JSON + PNG under docs/performance/.
+# Reproduce the speed/accuracy study: JSON + PNG under docs/performance/.
 #   benchmarks/run_all.sh            full size (hours on 2 CPU cores; minutes on a GPU box)
 #   benchmarks/run_all.sh --quick    minutes; writes *_quick.json / *_quick.png
 # Runs unchanged on CPU or GPU: JAX picks the device; every script prints versions + device.

@@ -1,4 +1,4 @@
-"""Stability map (issue 7): where do methods fail?
+"""Stability map: where do methods fail?
 
 (a) stiffness from the friction smoothing: eps = eps_R = 1e-2 ... 1e-10 on the stick-slip scene
     (1 period); Tsit5, Dopri8, Kvaerno5 with diffrax's chord root finder, Kvaerno5 with full

@@ -1,4 +1,4 @@
-"""Work-precision diagrams (issue 7): error at the stroboscopic times against wall time (compile
+"""Work-precision diagrams: error at the stroboscopic times against wall time (compile
 apart) and against right-hand-side evaluations, for diffrax explicit, implicit and fixed-step
 methods over tolerance / dt ladders; float64 and float32; every contact law in jc.CONTACT_LAWS.
 

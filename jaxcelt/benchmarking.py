@@ -1,7 +1,7 @@
 """Speed-against-accuracy analysis: test scenes, reference solutions, timed solver runs.
 
 The building blocks of ``benchmarks/{reference,work_precision,stability,peers}.py`` and of
-``notebooks/05_speed_accuracy.ipynb`` (issue 7). Nothing here is physics: every trajectory comes
+``notebooks/05_speed_accuracy.ipynb``. Nothing here is physics: every trajectory comes
 from `jaxcelt.simulate` (or from a peer integrator calling the same right-hand side).
 
 * `Scene` / `make_scene`: named test problems (from rest at omega_pi = 14, 17, 19; a fixed-table
@@ -409,15 +409,58 @@ def stability_results(folder: str = "docs/performance") -> dict[str, list[dict]]
     return out
 
 
-def load_results(folder: str = "docs/performance", quick: bool = False) -> dict[str, Any]:
+# The committed result files of the speed/accuracy study that notebooks read (shipped in the wheel
+# under jaxcelt/_results/performance, see [tool.hatch.build.targets.wheel.force-include]).
+RESULT_FILES: tuple[str, ...] = (
+    "reference.json",
+    "work_precision.json",
+    "peers.json",
+    "peers_idle.json",
+    "stability_a.json",
+    "stability_a_implicit.json",
+    "stability_a_eps1e-10.json",
+    "stability_b.json",
+    "stability_c.json",
+    "stability_d.json",
+    "stability_e.json",
+)
+
+
+def results_dir() -> Any:
+    """The folder holding the committed speed/accuracy results (`RESULT_FILES`).
+
+    An installed wheel has them as package data (``jaxcelt/_results/performance``); a checkout
+    (editable install) reads ``docs/performance`` of the repository. Raises ``FileNotFoundError``
+    when neither holds them, rather than letting a notebook show nothing."""
+    import pathlib
+    from importlib import resources
+
+    candidates = [
+        pathlib.Path(str(resources.files("jaxcelt") / "_results" / "performance")),
+        pathlib.Path(__file__).resolve().parents[1] / "docs" / "performance",
+    ]
+    for c in candidates:
+        if (c / "reference.json").is_file():
+            return c
+    raise FileNotFoundError(
+        "the committed speed/accuracy results (reference.json, ...) were found in neither "
+        + " nor ".join(str(c) for c in candidates)
+        + '; install jaxcelt from the repository (pip install "jaxcelt @ git+https://github.com/jaxcelt/jaxcelt")'
+    )
+
+
+def load_results(folder: Any = None, quick: bool = False) -> dict[str, Any]:
     """The JSON files written by ``benchmarks/*.py`` (missing ones are left out); the stability
-    study's per-part files come back as ``["stability"]`` = `stability_results` (full size only)."""
+    study's per-part files come back as ``["stability"]`` = `stability_results` (full size only).
+    ``folder`` defaults to `results_dir` (the committed results)."""
     import json
     import pathlib
 
+    if folder is None:
+        folder = results_dir()
     tag = "_quick" if quick else ""
     out = {}
-    for name in ("reference", "work_precision", "peers"):
+    for name in ("reference", "work_precision", "peers", "peers_idle"):
         f = pathlib.Path(folder) / f"{name}{tag}.json"
         if f.exists():
             out[name] = json.loads(f.read_text())

@@ -54,7 +54,7 @@ Execution model
   the first JAX operation: ``jax.config.update("jax_num_cpu_devices", K)`` (or
   ``XLA_FLAGS=--xla_force_host_platform_device_count=K``); the CLI does this by default
   (``--host-devices auto`` = number of cores). Measured on 2 cores: 400 x 300 periods in
-  11.3 s on 2 devices vs 23.6 s on 1 (session 5; docs/bifurcation/README.md). Results agree with the
+  11.3 s on 2 devices vs 23.6 s on 1 (docs/bifurcation/README.md). Results agree with the
   1-device run to ~1e-11 over a few periods (tests), not bitwise (a different compiled
   program): over hundreds of periods chaotic lanes diverge from that seed like any other.
 
@@ -1333,7 +1333,7 @@ def continuation(
             attractors show as differing branches.
         y0: None, (13,) or (K, 13): K starts continued side by side (vmapped).
         other arguments: as `sweep` (``t0`` is 0 for every step; the final state of a step
-        sits at a section time, base phase 0, so the restart is phase consistent).
+            sits at a section time, base phase 0, so the restart is phase consistent).
 
     Returns:
         ``{"up": SweepResult, "down": SweepResult}`` (the requested directions), values in

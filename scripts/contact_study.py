@@ -1,4 +1,4 @@
-"""Contact-law study (issue 4): writes docs/contact/*.png|json and the scene table.
+"""Contact-law study: writes docs/contact/*.png|json and the scene table.
 
     .venv/bin/python scripts/contact_study.py [--short] [--skip-ladder]
 

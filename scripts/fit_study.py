@@ -1,4 +1,4 @@
-"""Identification study for issue 6: writes docs/fit/*.json and *.png.
+"""Identification study: writes docs/fit/*.json and *.png.
 
 Sections (``--only`` picks some): ``recover`` (noise-free recovery, full state and IMU),
 ``compare`` (Adam vs L-BFGS vs Gauss-Newton vs LM on one problem), ``coverage`` (1% noise, 20

@@ -1,4 +1,4 @@
-"""Figs. 3-7 analogues for one reading of the paper (issue 5): diagram + four regime panels.
+"""Figs. 3-7 analogues for one reading of the paper: diagram + four regime panels.
 
     python scripts/paper_figures.py --psi0-deg 90 --eps 1e-4 --out docs/paper-reproduction
 

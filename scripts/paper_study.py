@@ -1,4 +1,4 @@
-"""Does any reading of the paper reproduce its regimes at 14, 15.6, 17, 19 rad/s? (issue 5)
+"""Does any reading of the paper reproduce its regimes at 14, 15.6, 17, 19 rad/s?
 
 The paper (section 3, Figs. 4-7) reports for q_pi = 0.04 m:
   14 rad/s periodic, bounded;  15.6 periodic (locally), unbounded;  17 quasi-periodic, bounded;

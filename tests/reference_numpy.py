@@ -253,7 +253,7 @@ def solve(p: dict, y0: np.ndarray, t_eval: np.ndarray, rtol: float = 1e-12, atol
     )
 
 
-# Aliases used by tests written by a concurrent session (same names, same meaning).
+# Aliases used by some tests (same names, same meaning).
 paper = paper_params
 
 
@@ -262,7 +262,3 @@ def pieces(t: float, y: np.ndarray, p: dict) -> dict:
     c = contact_quantities(t, y, p)
     short = dict(vsx="v_sx", vsy="v_sy", ws="omega_s", dc="d_c", ds="d_s", Tsx="T_sx", Tsy="T_sy", Ms="M_s")
     return {**c, **{k: c[v] for k, v in short.items()}}
-
-
-# ACK from the session that wrote test_regression.py / test_elliptic.py (03:58): split agreed --
-# it keeps test_regression.py, test_elliptic.py, test_scipy_reference.py and only appends here.

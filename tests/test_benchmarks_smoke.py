@@ -1,4 +1,4 @@
-"""Smoke tests of the speed/accuracy benchmarks' quick path (issue 7) on a tiny scene.
+"""Smoke tests of the speed/accuracy benchmarks' quick path on a tiny scene.
 
 No timings are asserted (machines differ); only accuracy statements that hold on any machine.
 """

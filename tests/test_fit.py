@@ -125,7 +125,7 @@ def test_fit_argument_errors(short_imu):
 @pytest.mark.slow
 @pytest.mark.parametrize("kinds", [("state",), ("omega",)])
 def test_must_show_1_recovery(kinds):
-    """Issue 6, must show 1: 1 s record, noise-free, parameters 30-60% off, start at the paper."""
+    """1 s record, noise-free, parameters 30-60% off, start at the paper."""
     data = generate_data(TRUE, _start(TRUE), 1.0, rate=100, kinds=kinds)
     res = jc.fit(data, PAPER, free=FREE, optimiser="lm", max_iter=60)
     assert max(res.relative_error(TRUE).values()) < 0.01
@@ -187,7 +187,7 @@ def test_gradient_norm_vs_window_matches_reverse_mode(short_imu):
 
 @pytest.mark.slow
 def test_must_show_3_chaotic_record_multiple_vs_single_shooting():
-    """Issue 6, must show 3: omega_pi = 19, 40 periods from rest (the record stays valid; its
+    """omega_pi = 19, 40 periods from rest (the record stays valid; its
     largest Lyapunov exponent is positive), start 35-50% off: multiple shooting (one window per
     period, states from the data, damped GN) recovers the parameters; single shooting from the
     same start does not (docs/identification.md, section 3: there it stalls after 1-3 accepted

@@ -79,7 +79,7 @@ def batch():
 
 
 def test_vmap_of_grad_matches_finite_differences(batch):
-    """Tolerance 1e-5 relative per component (issue 2). Measured: worst 1.5e-6 (b_Ts from rest,
+    """Tolerance 1e-5 relative per component. Measured: worst 1.5e-6 (b_Ts from rest,
     where dL/db_Ts = -3.6e-5 is four orders below the other components); typical 1e-9..1e-7."""
     thetas, y0s, vals, grads = batch
     assert np.all(np.isfinite(vals)) and np.all(np.isfinite(grads))

@@ -1,4 +1,4 @@
-"""Physical invariants along trajectories (issue 2, must-show 2; MODEL.md section 10).
+"""Physical invariants along trajectories (MODEL.md section 10).
 
 * mu = k_r = 0 on a fixed base: the contact force is normal (no work, no horizontal component,
   no moment about the vertical through C), so energy, horizontal momentum and (B omega) . n are
@@ -35,7 +35,7 @@ def conservative_run():
 
 
 def test_conserved_energy(conservative_run):
-    # Tolerance 1e-10 relative (issue 2). Measured: 8.3e-12 over 2 s (3735 Tsit5 steps at rtol 1e-11).
+    # Tolerance 1e-10 relative. Measured: 8.3e-12 over 2 s (3735 Tsit5 steps at rtol 1e-11).
     _, _, d = conservative_run
     E = np.asarray(d.energy)
     assert np.abs(E - E[0]).max() <= 1e-10 * abs(E[0])
@@ -58,7 +58,7 @@ def test_conserved_vertical_angular_momentum(conservative_run):
 
 
 def test_constraint_holds(conservative_run):
-    # |v_A . n| <= 1e-10 m/s (issue 2). Measured: 3.4e-11 m/s; contact height 3.3e-12 m; |n| - 1 4.4e-13.
+    # |v_A . n| <= 1e-10 m/s. Measured: 3.4e-11 m/s; contact height 3.3e-12 m; |n| - 1 4.4e-13.
     # The motion must be non-trivial for this to mean anything: tilt varies by degrees, N stays > 0.
     _, _, d = conservative_run
     assert np.abs(np.asarray(d.normal_velocity)).max() <= 1e-10

@@ -1,4 +1,4 @@
-"""Symmetries of the model (issue 2, must-show 3; MODEL.md section 10 "Mirror").
+"""Symmetries of the model (MODEL.md section 10 "Mirror").
 
 Derivation (used by `transform_state`). Take a body relabelling/reflection Q (body components
 x' = Q x, Q = diag(+-1, +-1, +-1)) and a global reflection/rotation M with M e3 = e3 (the base and

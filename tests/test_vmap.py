@@ -1,4 +1,4 @@
-"""Batching and compilation of `simulate` (issue 2, must-show 6), plus an implicit-solver smoke test.
+"""Batching and compilation of `simulate` , plus an implicit-solver smoke test.
 
 * A vmapped batch of 64 parameter sets (and initial states) equals 64 single runs to 1e-11 (identical step sequences; rounding only).
 * New parameter values, initial states, t1, save times and tolerances do not retrace the solve.

@@ -1,4 +1,4 @@
-"""The work-precision analysis path (issue 7) on a synthetic results dict: no solves, no timings.
+"""The work-precision analysis path on a synthetic results dict: no solves, no timings.
 
 Checks that `benchmarks/work_precision.py`'s cheapest-per-target selection and Markdown report pick
 the right runs, and that `jaxcelt.plotting.performance.plot_work_precision` draws one log-log figure

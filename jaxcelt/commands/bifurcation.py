@@ -1,7 +1,8 @@
 """``jaxcelt bifurcation``: a stroboscopic sweep -> dataset (netCDF) + figures (PNG) + summary (JSON).
 
-Defaults are a coarse, laptop-sized version of the paper's Fig. 3 (a few minutes on 2 CPU
-cores); the full benchmark size is ``--omega 10:20:400 --transient 200 --sample 100``.
+Defaults are a coarse, laptop-sized version of the paper's Fig. 3 (60 frequencies; under a minute
+on 2 CPU cores, most of it compilation: docs/bifurcation/README.md); the full benchmark size is
+``--omega 10:20:400 --transient 200 --sample 100``.
 Interrupting and rerunning the same command resumes from the finished chunks.
 """
 

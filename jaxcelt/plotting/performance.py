@@ -1,4 +1,4 @@
-"""Charts of the speed/accuracy study (issue 7): reference agreement, work-precision diagrams,
+"""Charts of the speed/accuracy study: reference agreement, work-precision diagrams,
 stability map, peer comparison. Each function takes the JSON-able dicts written by
 ``benchmarks/*.py`` and returns matplotlib figures (never shows or saves)."""
 

@@ -1,4 +1,4 @@
-"""Charts of the stability map (issue 7, ``benchmarks/stability.py``): verdict grid over
+"""Charts of the stability map (``benchmarks/stability.py``): verdict grid over
 (method, eps), fixed-step error against dt, float32/float64 separation, gradient norm against
 horizon. Each function takes the rows of a ``docs/performance/stability_<part>.json`` file and
 returns a matplotlib figure (never shows or saves)."""

@@ -1,0 +1,214 @@
+"""Numbers quoted in the README and the guides against the committed result files they come from.
+
+Each check recomputes a quoted number from its JSON file (or from the test collection) and asserts
+that the document contains it as written. A failure means a result file was regenerated (or a test
+added) without updating the prose, or the prose was edited without a result behind it.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+
+
+def _text(rel: str) -> str:
+    return (ROOT / rel).read_text(encoding="utf-8")
+
+
+def _json(rel: str):
+    return json.loads((ROOT / rel).read_text(encoding="utf-8"))
+
+
+def _bench():
+    return _json("docs/bifurcation/bench_sweep_400x300.json")
+
+
+def _starts() -> set[str]:
+    """Distinct initial conditions over the paper-reproduction study files (same start, one name)."""
+    alias = {"rest psi0=0": "rest psi0=0deg", "rest psi0=pi/2": "rest psi0=90deg"}
+    ics = set()
+    for f in sorted((DOCS / "paper-reproduction").glob("study_*.json")):
+        ics |= {alias.get(r["ic"], r["ic"]) for r in json.loads(f.read_text())["rows"]}
+    return ics
+
+
+def _lambda14() -> tuple[float, float]:
+    lam = [
+        r["lyapunov"]
+        for f in (DOCS / "paper-reproduction").glob("study_*.json")
+        for r in json.loads(f.read_text())["rows"]
+        if r["omega_pi"] == 14.0 and r["lyapunov"] is not None
+    ]
+    return min(lam), max(lam)
+
+
+# (document, quoted text computed from the result file)
+QUOTES = [
+    # main job and the full-size CLI run (summary.json written by `jaxcelt bifurcation`)
+    (
+        "README.md",
+        lambda: (
+            f"{_json('docs/bifurcation/summary.json')['wall_seconds_including_compile']:.1f} s including compilation"
+        ),
+    ),
+    (
+        "docs/bifurcation/README.md",
+        lambda: f"took {_json('docs/bifurcation/summary.json')['wall_seconds_including_compile']:.1f} s",
+    ),
+    (
+        "docs/bifurcation/README.md",
+        lambda: (
+            f"{_json('docs/bifurcation/summary.json')['lanes_invalid']} of {_json('docs/bifurcation/summary.json')['n_values']} lanes"
+        ),
+    ),
+    (
+        "docs/bifurcation/README.md",
+        lambda: (
+            f"**{_json('docs/bifurcation/summary_400x300.json')['wall_seconds_including_compile']:.2f} s including compilation**"
+        ),
+    ),
+    (
+        "docs/bifurcation/README.md",
+        lambda: f"{_json('docs/bifurcation/summary_400x300.json')['lanes_invalid']} of the 400 lanes",
+    ),
+    # the side-by-side sweep benchmark (benchmarks/bench_sweep.py)
+    ("docs/bifurcation/README.md", lambda: f"**{_bench()['summary']['jaxcelt_stop_on_invalid_s']:.2f}**"),
+    ("docs/bifurcation/README.md", lambda: f"**{_bench()['summary']['jaxcelt_dopri8_stop_on_invalid_s']:.2f}**"),
+    (
+        "docs/bifurcation/README.md",
+        lambda: (
+            f"{_bench()['jaxcelt_pool']['seconds']:.1f} (+ {_bench()['jaxcelt_pool']['compile_seconds']:.1f} compile)"
+        ),
+    ),
+    ("docs/bifurcation/README.md", lambda: f"{_bench()['summary']['jaxcelt_stop_on_invalid_1dev_s']:.1f} (+"),
+    (
+        "docs/bifurcation/README.md",
+        lambda: f"**{_bench()['scipy_dop853_numba_rhs_stop_on_invalid']['seconds']:.1f} (all 400 lanes, measured)**",
+    ),
+    (
+        "docs/bifurcation/README.md",
+        lambda: f"{_bench()['summary']['speedup_vs_scipy_loop_same_work_stop']:.1f}× (Tsit5)",
+    ),
+    (
+        "docs/bifurcation/README.md",
+        lambda: f"{_bench()['summary']['speedup_vs_scipy_loop_same_work_stop_dopri8']:.1f}× (Dopri8)",
+    ),
+    (
+        "docs/bifurcation/README.md",
+        lambda: (
+            f"Integrating every lane on: {_bench()['summary']['speedup_vs_scipy_loop_same_work_integrate_on']:.0f}×"
+        ),
+    ),
+    (
+        "docs/bifurcation/README.md",
+        lambda: f"{1 / _bench()['summary']['wall_ratio_vs_numba_ensemble_stop']:.2f}× faster than the numba",
+    ),
+    (
+        "docs/bifurcation/README.md",
+        lambda: f"{_bench()['summary']['wall_ratio_vs_numba_ensemble_integrate_on']:.2f}× slower integrating on",
+    ),
+    # equal work against one simulate at a time: both integrate every lane on
+    (
+        "docs/bifurcation/README.md",
+        lambda: (
+            f"{_bench()['jaxcelt_lane_by_lane']['seconds'] / _bench()['jaxcelt_pool']['seconds']:.1f}× (1 197 s extrapolated against the pool's {_bench()['jaxcelt_pool']['seconds']:.1f} s)"
+        ),
+    ),
+    (
+        "docs/bifurcation/README.md",
+        lambda: f"{_bench()['summary']['total_with_compile_s']:.1f} s including compile in the benchmark",
+    ),
+    ("docs/performance.md", lambda: f"jaxcelt is {1 / _bench()['summary']['wall_ratio_vs_numba_ensemble_stop']:.2f}×"),
+    (
+        "docs/performance.md",
+        lambda: f"ensemble is {_bench()['summary']['wall_ratio_vs_numba_ensemble_integrate_on']:.2f}× faster",
+    ),
+    # per-step cost table (benchmarks/bench_step_parts.py)
+    (
+        "docs/bifurcation/README.md",
+        lambda: f"**{_json('docs/bifurcation/step_parts.json')['us_per_lane']['fused step (pool)']:.2f}**",
+    ),
+    (
+        "docs/bifurcation/README.md",
+        lambda: f"| {_json('docs/bifurcation/step_parts.json')['us_per_lane']['diffrax tsit5 step + monitor']:.2f} |",
+    ),
+    # paper reproduction (scripts/paper_study.py, scripts/paper_figures.py)
+    ("README.md", lambda: f"{len(_starts())} initial conditions"),
+    ("docs/paper-reproduction.md", lambda: f"{len(_starts())} starts"),
+    ("docs/paper-reproduction.md", lambda: "λ₁ = {:.2f}–{:.2f} s⁻¹ over all the study files".format(*_lambda14())),
+    (
+        "docs/paper-reproduction.md",
+        lambda: (
+            f"took {_json('docs/paper-reproduction/figures_psi157.5.json')['diagram_wall_s']:.0f} s, {_json('docs/paper-reproduction/figures_psi157.5.json')['wall_s']:.0f} s with"
+        ),
+    ),
+]
+
+
+@pytest.mark.parametrize("doc,quote", QUOTES, ids=[f"{d}:{i}" for i, (d, _) in enumerate(QUOTES)])
+def test_quoted_number_matches_its_result_file(doc, quote):
+    text = " ".join(_text(doc).split())  # line breaks in prose are spaces
+    expected = quote()
+    assert expected in text, f"{doc} should quote {expected!r} (from its result file)"
+
+
+def test_heading_study_has_sixteen_headings_and_a_roll():
+    # "17 starts: rest at 16 headings and a 2° roll" (README, paper-reproduction.md)
+    starts = _starts()
+    assert sum(s.startswith("rest psi0=") for s in starts) == 16
+    assert starts - {s for s in starts if s.startswith("rest psi0=")} == {"roll 2deg"}
+
+
+def test_best_score_is_six_of_eight():
+    scores = [
+        row["score_allowed"]
+        for f in (DOCS / "paper-reproduction").glob("study_*.json")
+        for row in json.loads(f.read_text())["table"]
+        if "score_allowed" in row
+    ]
+    assert max(scores) == 6
+
+
+def test_repository_url_is_declared_once_and_used_by_the_notebooks():
+    url = tomllib.loads(_text("pyproject.toml"))["project"]["urls"]["Repository"]
+    for nb in sorted((ROOT / "notebooks").glob("*.ipynb")):
+        src = "".join("".join(c["source"]) for c in json.loads(nb.read_text())["cells"] if c["cell_type"] == "code")
+        installs = re.findall(r"%pip install[^\n]*", src)
+        assert installs and all(f"git+{url}" in line for line in installs), nb.name
+    cff = _text("CITATION.cff")
+    assert f'repository-code: "{url}"' in cff
+    assert "10.5890/DNC.2014.06.002" in cff and "10.5890/DNC.2014.06.002" in _text("docs/MODEL.md")
+
+
+def test_notebook_results_are_shipped_with_the_package():
+    # every result file notebook 05 reads (jaxcelt.benchmarking.RESULT_FILES) is committed and force-included
+    from jaxcelt.benchmarking import RESULT_FILES
+
+    forced = tomllib.loads(_text("pyproject.toml"))["tool"]["hatch"]["build"]["targets"]["wheel"]["force-include"]
+    for name in RESULT_FILES:
+        assert (DOCS / "performance" / name).is_file(), name
+        assert forced[f"docs/performance/{name}"] == f"jaxcelt/_results/performance/{name}"
+
+
+def test_readme_test_count():
+    # "The second runs the default test suite (N tests, ...)": the number pytest collects with -m "not slow"
+    out = subprocess.run(
+        [sys.executable, "-m", "pytest", "--collect-only", "-q", "-m", "not slow", "-p", "no:cacheprovider"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
+    m = re.search(r"(\d+)/\d+ tests collected", out) or re.search(r"(\d+) tests collected", out)
+    assert m, out[-500:]
+    quoted = re.search(r"default test suite \((\d+) tests", _text("README.md"))
+    assert quoted and int(quoted[1]) == int(m[1]), f"README says {quoted and quoted[1]}, pytest collects {m[1]}"
