@@ -97,7 +97,7 @@ def time_jaxcelt(p, vals, transient, a, scheduler, stop, devices, solver=None, r
     solver = solver if solver is not None else diffrax.Tsit5()
     kw = dict(
         sample_periods=a.sample, rtol=a.rtol, atol=a.atol, chunk_size=a.chunk_size, sort_by_cost=True,
-        scheduler=scheduler, width=a.width, stop_on_invalid=stop, devices=devices, solver=solver,
+        width=a.width, stop_on_invalid=stop, devices=devices, solver=solver,
     )  # fmt: skip
     cs = min(a.chunk_size, len(vals))
     t = time.perf_counter()
@@ -235,7 +235,6 @@ def main():
         "--width", type=int, default=None, help="pool slots per device (vmap width; default: the library's DEFAULT_WIDTH)"
     )
     ap.add_argument("--host-devices", default="auto", help="CPU JAX devices to shard lanes over ('auto' = CPU cores)")
-    ap.add_argument("--with-chunks", action="store_true", help="also time the old chunk scheduler")
     ap.add_argument("--subset", type=int, default=8, help="lanes (evenly spread) for the lane-by-lane methods")
     ap.add_argument(
         "--scipy-stop-lanes", default="all",
@@ -257,7 +256,6 @@ def main():
     jax.config.update("jax_num_cpu_devices", n_host)  # before the first JAX operation
     if a.quick:
         a.n_freq, a.periods, a.sample, a.subset = 40, 40, 10, 4
-        a.with_chunks = True
     transient = a.periods - a.sample
     V = versions()
     devs = jax.devices()
@@ -301,8 +299,6 @@ def main():
     ]
     if len(devs) > 1:
         runs.insert(1, ("pool_stop_on_invalid_1dev", "pool", True, devs[:1], None))
-    if a.with_chunks:
-        runs.append(("chunks", "chunks", False, devs, None))
     for key, sched, stop, dv, solver in runs:
         res[f"jaxcelt_{key}"] = time_jaxcelt(p, vals, transient, a, sched, stop, dv, solver, a.reps if stop else 1)
         print(key, res[f"jaxcelt_{key}"], flush=True)

@@ -51,6 +51,25 @@ class DamagedChunkWarning(RuntimeWarning):
     """A chunk file of an interrupted sweep could not be used on resume; the chunk is recomputed."""
 
 
+LANE_FIELDS = (
+    "t_samples",
+    "samples",
+    "y_final",
+    "status",
+    "valid",
+    "first_invalid_t",
+    "first_invalid_kind",
+    "min_N",
+    "max_tilt",
+    "drift",
+    "max_excursion",
+    "num_steps",
+    "lyapunov",
+    "r_O",
+)
+"""per-lane arrays of a sweep (the fields of `jaxcelt.sweep.SweepResult` but ``values``), in
+dataset order; sweep.py imports this module, not the other way round"""
+
 _LANE_DIMS: dict[str, tuple[str, ...]] = {
     "t_samples": ("sample",),
     "samples": ("sample", "state"),
@@ -121,12 +140,8 @@ def _attrs(params: CeltParams, name: str, config: Any, n_starts: int) -> dict[st
 
 def _lane_variables(fields: dict[str, Any], lead: tuple[str, ...], **classify_kwargs) -> dict[str, xr.Variable]:
     """Dataset variables (and regime labels) from lane arrays with leading dims ``lead``."""
-    from .sweep import _LANE_FIELDS
-
     data = {}
-    for key in _LANE_FIELDS:
-        if key == "values":
-            continue
+    for key in LANE_FIELDS:
         arr = np.asarray(fields[key])
         if arr.dtype == bool:
             arr = arr.astype(np.int8)
@@ -154,9 +169,7 @@ def to_dataset(result: Any, params: CeltParams, config: Any, **classify_kwargs) 
     coords: dict[str, Any] = {name: vals[:, 0] if multi else vals, **_base_coords(np.shape(result.samples)[-2])}
     if multi:
         coords["start"] = np.arange(vals.shape[1])
-    from .sweep import _LANE_FIELDS
-
-    fields = {k: getattr(result, k) for k in _LANE_FIELDS}
+    fields = {k: getattr(result, k) for k in LANE_FIELDS}
     data = _lane_variables(fields, lead, **classify_kwargs)
     attrs = _attrs(params, name, config, vals.shape[1] if multi else 1)
     attrs["classify_json"] = json.dumps(classify_kwargs, sort_keys=True)

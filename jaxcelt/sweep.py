@@ -9,8 +9,8 @@ steps exactly onto every t_k.
 
 Execution model
 ---------------
-* Lanes are processed in chunks of ``chunk_size`` (the unit of resumable writing). The
-  default ``scheduler="pool"`` runs a chunk as **one** jitted while loop over ``width``
+* Lanes are processed in chunks of ``chunk_size`` (the unit of resumable writing). A chunk
+  runs as **one** jitted while loop over ``width``
   batch slots (`_pool`): each iteration makes one step in every slot, and a slot whose lane
   finished is refilled with the next lane at once. Step slots are therefore only wasted in
   the final drain, not for every lane until the slowest one is done. The step is the
@@ -40,8 +40,6 @@ Execution model
   longest first. The optional Lyapunov stage then runs
   vmapped over the successful lanes in groups of ``width`` ordered by the measured
   main-solve step count.
-* ``scheduler="chunks"`` (the previous engine): a chunk is one ``jax.vmap`` of `simulate`;
-  the vmapped while loop runs until the chunk's slowest lane is done.
 * ``stop_on_invalid=True`` ends a lane at the first accepted step whose end state is
   invalid (lift-off N <= 0, n3 <= 0, denominator <= 0; the model does not hold past it):
   status 2, samples after the stop inf, no Lyapunov exponent. Default False (integrate on
@@ -247,72 +245,6 @@ def _extras(ys: Array, p: CeltParams) -> dict[str, Array]:
     drift = jnp.where(last >= 0, dist[jnp.maximum(last, 0)], jnp.nan)
     exc = jnp.where(last >= 0, jnp.max(jnp.where(fin, dist, -jnp.inf)), jnp.nan)
     return dict(drift=drift, max_excursion=exc, r_O=r_O)
-
-
-def _lane(p: CeltParams, y0: Array, transient: Array, cfg: SweepConfig) -> dict[str, Array]:
-    """One lane: transient, exact stroboscopic samples, extras, optional Lyapunov exponent.
-
-    ``transient`` (periods, traced so that changing it does not recompile) overrides
-    ``cfg.transient_periods``.
-    """
-    T = 2 * jnp.pi / p.omega_pi
-    t0 = jnp.asarray(cfg.t0, jnp.float64)
-    ts = t0 + T * (transient + jnp.arange(cfg.sample_periods, dtype=jnp.float64))
-    sol = simulate(
-        p,
-        y0,
-        ts[-1],
-        ts=ts,
-        t0=t0,
-        solver=cfg.solver,
-        rtol=cfg.rtol,
-        atol=cfg.atol,
-        max_steps=cfg.max_steps,
-        contact_law=cfg.contact_law,
-        exact_ts=True,
-        stop_on_invalid=cfg.stop_on_invalid,
-    )
-    ys = sol.ys
-    out = dict(
-        t_samples=ts,
-        samples=ys,
-        y_final=ys[-1],
-        status=sol.status,
-        valid=sol.valid,
-        first_invalid_t=sol.validity.first_invalid_t,
-        first_invalid_kind=sol.validity.first_invalid_kind,
-        min_N=sol.validity.min_N,
-        max_tilt=sol.validity.max_tilt,
-        num_steps=sol.num_steps,
-        **_extras(ys, p),
-    )
-    if cfg.lyapunov_periods > 0:
-        ok = sol.status == 0
-        y_start = jnp.where(ok, ys[0], y0)  # a failed lane still runs (masked) but is NaN
-        lr = celt_lyapunov(
-            p,
-            y_start,
-            periods=cfg.lyapunov_periods,
-            t0=ts[0],
-            contact_law=cfg.contact_law,
-            solver=cfg.solver,
-            rtol=cfg.rtol,
-            atol=cfg.atol,
-            max_steps=cfg.max_steps,  # per period: a bound, not a cost
-        )
-        out["lyapunov"] = jnp.where(ok, lr.exponent, jnp.nan)
-    else:
-        out["lyapunov"] = jnp.full((), jnp.nan)
-    return out
-
-
-@eqx.filter_jit
-def _chunk(pb: CeltParams, y0b: Array, transient: Array, cfg: SweepConfig, mesh: Any) -> dict[str, Array]:
-    run = jax.vmap(lambda p, y: _lane(p, y, transient, cfg))
-    if mesh is None:
-        return run(pb, y0b)
-    spec = jax.sharding.PartitionSpec("lanes")
-    return jax.shard_map(run, mesh=mesh, in_specs=(spec, spec), out_specs=spec, check_vma=False)(pb, y0b)
 
 
 # --------------------------------------------------------------------------------------
@@ -812,7 +744,6 @@ def _pad(x: np.ndarray, n: int) -> np.ndarray:
     return np.concatenate([x, np.repeat(x[-1:], n - len(x), axis=0)])
 
 
-SCHEDULERS = ("pool", "chunks")
 DEFAULT_WIDTH = 96
 """pool slots per device. Each pool iteration pays a fixed cost (~330 XLA kernel launches,
 ~30 us on CPU) besides its per-slot work, so wider pools finish in fewer iterations; with the
@@ -831,7 +762,6 @@ def run_lanes(
     *,
     devices: Sequence[Any] | None = None,
     pad_to: int | None = None,
-    scheduler: str = "pool",
     width: int | None = None,
     compile_only: bool = False,
     varying: Sequence[str] = (),
@@ -839,7 +769,7 @@ def run_lanes(
 ) -> dict[str, np.ndarray]:
     """Run one chunk of lanes (batched params and y0 with a leading lane axis) and return numpy arrays.
 
-    ``scheduler="pool"`` (default): ``width`` batch slots per device (default
+    ``width`` batch slots per device (default
     `DEFAULT_WIDTH`) step in one jitted while loop; a slot whose lane finishes is refilled
     with the next lane at once, so no slot idles until the slowest lane is done (only the
     final drain does). ``pilot_fraction`` (default `PILOT_FRACTION`; 0 = off; only used
@@ -847,8 +777,6 @@ def run_lanes(
     its time span and is taken up again costliest-predicted first (see `_pool`). The Lyapunov stage (``cfg.lyapunov_periods > 0``) then runs vmapped
     over the successful lanes in groups of ``width`` ordered by the measured main-solve
     step count (a cost estimate that needs no pilot run).
-    ``scheduler="chunks"``: the whole chunk is one vmapped `simulate` (every slot runs until
-    the chunk's slowest lane is done).
 
     Sharded over ``devices`` (default all local devices; lanes are dealt round-robin); padded
     to ``pad_to`` lanes (so a short last chunk reuses the compiled shape) and to a multiple
@@ -860,8 +788,6 @@ def run_lanes(
     so that all chunks of a sweep compile to one kernel; the others are constants of the
     pool's step (see `_pool`).
     """
-    if scheduler not in SCHEDULERS:
-        raise ValueError(f"scheduler must be one of {SCHEDULERS}, got {scheduler!r}")
     mesh = _mesh(devices)
     L = int(np.shape(y0b)[0])
     ndev = 1 if mesh is None else mesh.devices.size
@@ -870,9 +796,6 @@ def run_lanes(
     y0_np = _pad(np.asarray(y0b, dtype=np.float64), Lp)
     static_cfg = dataclasses.replace(cfg, transient_periods=0)  # transient is traced: no recompiles
     transient = jnp.asarray(float(cfg.transient_periods))
-    if scheduler == "chunks":
-        out = _chunk(pb_np, y0_np, transient, static_cfg, mesh)
-        return jax.tree_util.tree_map(lambda x: np.asarray(x)[:L], jax.block_until_ready(out))
     W = int(width or DEFAULT_WIDTH)
     if W < 1:
         raise ValueError(f"width must be >= 1, got {width!r}")
@@ -964,7 +887,6 @@ def _run_chunked(
     done: dict[int, dict[str, np.ndarray]],
     *,
     devices: Sequence[Any] | None,
-    scheduler: str,
     width: int | None,
     varying: Sequence[str],
     progress: bool,
@@ -989,9 +911,7 @@ def _run_chunked(
             continue
         pb = jax.tree_util.tree_map(lambda x, idx=idx: np.asarray(x)[idx], pb_all)
         t_start = time.perf_counter()
-        res = run_lanes(
-            pb, lane_y0[idx], cfg, devices=devices, pad_to=pad_to, scheduler=scheduler, width=width, varying=varying
-        )
+        res = run_lanes(pb, lane_y0[idx], cfg, devices=devices, pad_to=pad_to, width=width, varying=varying)
         res["_seconds"] = np.full(len(idx), (time.perf_counter() - t_start) / len(idx))
         results[ci] = res
         if writer is not None:
@@ -1063,7 +983,6 @@ def sweep(
     chunk_size: int | None = None,
     sort_by_cost: bool = False,
     stop_on_invalid: bool = False,
-    scheduler: str = "pool",
     width: int | None = None,
     devices: Sequence[Any] | None = None,
     out: str | None = None,
@@ -1090,8 +1009,6 @@ def sweep(
         stop_on_invalid: end each lane at its first invalid state (lift-off, n3 <= 0):
             status 2, samples after the stop inf, no Lyapunov exponent. Default False (the
             model is integrated on, validity reported), as in `jaxcelt.simulate`.
-        scheduler: ``"pool"`` (default: ``width`` slots refilled as lanes finish) or
-            ``"chunks"`` (one vmapped `simulate` per chunk); see `run_lanes`.
         width: batch slots per device of the pool (default `DEFAULT_WIDTH`).
         devices: devices to shard each chunk over (default all local devices).
         out: directory; write the dataset chunk by chunk there and resume a previous,
@@ -1108,8 +1025,6 @@ def sweep(
         transient_periods, sample_periods, lyapunov_periods, rtol, atol, max_steps, solver, contact_law, t0,
         stop_on_invalid,
     )  # fmt: skip
-    if scheduler not in SCHEDULERS:
-        raise ValueError(f"scheduler must be one of {SCHEDULERS}, got {scheduler!r}")
     values = np.atleast_1d(np.asarray(values, dtype=np.float64))
     if values.ndim != 1 or values.size == 0:
         raise ValueError(f"values must be a non-empty 1-D array, got shape {values.shape}")
@@ -1151,7 +1066,7 @@ def sweep(
 
     lanes = _run_all(
         pb_all, lane_y0, cfg, chunks, cs, writer, done,
-        devices=devices, scheduler=scheduler, width=width, varying=(name,),
+        devices=devices, width=width, varying=(name,),
         progress=progress, desc=f"sweep {name}", on_chunk=on_chunk,
     )  # fmt: skip
     if lanes is None:  # a process other than 0 of a multi-process sweep: its chunks are on disk
@@ -1218,7 +1133,6 @@ def parameter_map(
     chunk_size: int | None = None,
     sort_by_cost: bool = False,
     stop_on_invalid: bool = False,
-    scheduler: str = "pool",
     width: int | None = None,
     devices: Sequence[Any] | None = None,
     out: str | None = None,
@@ -1251,8 +1165,6 @@ def parameter_map(
         transient_periods, sample_periods, lyapunov_periods, rtol, atol, max_steps, solver, contact_law, t0,
         stop_on_invalid,
     )  # fmt: skip
-    if scheduler not in SCHEDULERS:
-        raise ValueError(f"scheduler must be one of {SCHEDULERS}, got {scheduler!r}")
     for arg, spec in (("x", x), ("y", y)):
         if not (isinstance(spec, tuple | list) and len(spec) == 2 and isinstance(spec[0], str)):
             raise ValueError(f"{arg} must be a (parameter name, values) pair, got {spec!r}")
@@ -1298,7 +1210,7 @@ def parameter_map(
         done = writer.load_done()
     lanes = _run_all(
         pb_all, lane_y0, cfg, chunks, cs, writer, done,
-        devices=devices, scheduler=scheduler, width=width, varying=(xn, yn),
+        devices=devices, width=width, varying=(xn, yn),
         progress=progress, desc=f"map {xn} x {yn}", on_chunk=on_chunk,
     )  # fmt: skip
     if lanes is None:  # a process other than 0 of a multi-process map

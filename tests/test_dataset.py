@@ -147,3 +147,14 @@ def test_killed_and_resumed(tmp_path):
     a, b = open_sweep(out), open_sweep(ref)
     assert a.identical(b)
     print(textwrap.dedent(f"killed after {n_before} of 4 chunks; resumed dataset identical"))
+
+
+def test_lane_fields_match_sweep_result():
+    # dataset.py lists the lane variables itself (it does not import the sweep engine): the list
+    # must be SweepResult's fields, in order
+    import dataclasses
+
+    from jaxcelt.dataset import LANE_FIELDS
+    from jaxcelt.sweep import SweepResult
+
+    assert LANE_FIELDS == tuple(f.name for f in dataclasses.fields(SweepResult) if f.name not in ("name", "values"))
