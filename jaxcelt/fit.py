@@ -16,8 +16,9 @@ Residuals r(z) (all dimensionless, stacked into one vector):
 
 loss = 1/2 |r|^2. Optimisers: ``"lm"`` (optimistix Levenberg-Marquardt, forward-mode Jacobians via
 ``diffrax.ForwardMode``), ``"gn"`` (optimistix Gauss-Newton), ``"gn-damped"`` (Gauss-Newton with a
-backtracking Armijo line search), ``"adam"`` and ``"lbfgs"`` (optax,
-reverse-mode gradients). Uncertainty (`FitResult.stderr`, ``ci95``, ``corr``): the Gauss-Newton
+backtracking Armijo line search), ``"adam"`` and ``"lbfgs"`` (optax; gradient J^T r from the same
+forward-mode Jacobian). One program per problem shape holds the ODE solves (every record, padded
+to a common length, in one `jax.lax.map`); the optimisers call it through `jax.pure_callback`. Uncertainty (`FitResult.stderr`, ``ci95``, ``corr``): the Gauss-Newton
 approximation cov(z) = s^2 (J^T J)^-1 at the optimum with s^2 = RSS_misfit / (n_data - n_unknowns),
 marginalised over the window states, mapped to the physical parameters by the delta method.
 
@@ -322,7 +323,7 @@ class FitResult:
     corr (P, P): correlation matrix of the free parameters; s2: residual variance factor;
     loss_history, param_history (iteration -> loss, dict of values); wall_time [s] of the
     optimisation after compilation, compile_time [s] of the first iteration, total_time [s];
-    n_iter; converged: the optimiser's own criterion (LM/GN) or the loss/step criterion (optax).
+    n_iter; converged: the optimiser's own criterion (LM/GN) or the gradient-norm test (optax, ``gtol``).
     z: final unknowns; problem: the residual function (for `predict`, plotting).
     """
 
@@ -674,7 +675,8 @@ def fit(
             reading switches and the per-record omega_pi, q_pi).
         optimiser: ``"lm"`` (optimistix Levenberg-Marquardt), ``"gn"`` (plain Gauss-Newton, full
             steps), ``"gn-damped"`` (Gauss-Newton with a backtracking line search), all with
-            forward-mode Jacobians; ``"adam"`` or ``"lbfgs"`` (optax, reverse-mode gradients).
+            forward-mode Jacobians; ``"adam"`` (cosine-decayed step) or ``"lbfgs"`` (zoom line
+            search), optax, with the gradient J^T r from the same forward-mode Jacobian.
         weights: extra weight per observation kind (default 1; residuals are already /sigma).
         transforms: per-parameter transforms overriding `DEFAULT_TRANSFORMS` (else `Positive`).
         windows: number of multiple-shooting windows per record (1 = single shooting).
@@ -686,10 +688,12 @@ def fit(
         continuity_weight: weight of the continuity and gauge residuals (residual scale
             `STATE_SCALE` / sqrt(weight)).
         max_iter: iteration budget. rtol, atol: optimistix termination (relative/absolute change
-            of z and of the loss); optax optimisers stop when the relative loss change < rtol
-            over 5 iterations.
-        sim_rtol, sim_atol, max_steps: integrator settings.
-        learning_rate: Adam step size in z (log-relative units for `Positive` parameters).
+            of z and of the loss).
+        sim_rtol, sim_atol, max_steps: integrator settings (max_steps per solve: a trial step into a
+            stiff region fails fast at the cap and is rejected).
+        learning_rate: Adam initial step size in z (log-relative units for `Positive`
+            parameters), decayed by a cosine schedule to 1e-3 of it over ``max_iter``.
+        gtol: optax optimisers stop, converged, when |grad loss| <= gtol |grad loss at start|.
         uncertainty: compute standard errors, intervals and correlations.
         max_time: wall-clock budget [s] for the iterations (checked after each iteration;
             compilation included); the fit stops unconverged when it is spent.
