@@ -18,7 +18,21 @@ def register(sub) -> None:
         description="Fit parameters of the model to measured trajectories (file format: jaxcelt.data).",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
-    p.add_argument("data", type=Path, help="data file written by jaxcelt.data.save_data (.npz or .nc)")
+    p.add_argument(
+        "data",
+        type=Path,
+        nargs="+",
+        help="data file written by jaxcelt.data.save_data (.npz or .nc), or one CSV per record "
+        "(columns t, omega1..3, ...: jaxcelt.data.load_csv, docs/identification.md)",
+    )
+    p.add_argument(
+        "--guess",
+        default="",
+        metavar="NAME=VALUE,...",
+        help="initial guess, e.g. mu=0.2,k_r=0.4 (same as --set; applied after it)",
+    )
+    p.add_argument("--omega-pi", type=float, default=None, help="base frequency [rad/s] for CSV records without one")
+    p.add_argument("--q-pi", type=float, default=None, help="base amplitude [m] for CSV records without one")
     p.add_argument("--free", nargs="+", default=["mu", "k_r", "b_Ts", "m_Ts"], help="parameters to fit")
     p.add_argument(
         "--set",
@@ -47,14 +61,20 @@ def run(args) -> int:
 
     import jaxcelt as jc
     from jaxcelt.commands.simulate import parse_overrides
-    from jaxcelt.data import load_data
+    from jaxcelt.data import MeasuredData, load_csv, load_data
     from jaxcelt.fit import fit
 
     try:
-        data = load_data(args.data)
+        if all(p.suffix.lower() == ".csv" for p in args.data):
+            data = MeasuredData(tuple(load_csv(p, omega_pi=args.omega_pi, q_pi=args.q_pi) for p in args.data))
+        elif len(args.data) == 1:
+            data = load_data(args.data[0])
+        else:
+            raise ValueError("data: several files must all be CSV records (one .npz/.nc holds several records)")
         if args.kinds:
             data = data.subset(args.kinds)
-        params0 = jc.CeltParams.paper(**parse_overrides(args.set))
+        guess = [g for g in args.guess.split(",") if g.strip()]
+        params0 = jc.CeltParams.paper(**parse_overrides(list(args.set) + guess))
     except (ValueError, OSError, KeyError) as e:
         print(f"jaxcelt fit: {e}")
         return 2
@@ -87,7 +107,7 @@ def run(args) -> int:
     from jaxcelt.versions import versions
 
     (args.out / "fit.json").write_text(
-        json.dumps(res.to_dict() | {"data": str(args.data), "versions": versions()}, indent=1)
+        json.dumps(res.to_dict() | {"data": [str(p) for p in args.data], "versions": versions()}, indent=1)
     )
     print(f"wrote {args.out / 'fit.json'}")
     if not args.no_plot:
