@@ -237,3 +237,23 @@ def test_cli_fit_csv_round_trip(tmp_path, short_imu, capsys):
     # after 4 LM iterations the loss fell from its value at the guess
     assert out["loss_history"][-1] < out["loss_history"][0]
     assert out["param_history"][0]["mu"] != pytest.approx(0.2241)  # the guess was used, not the paper
+
+
+@pytest.mark.slow
+def test_multistart_and_profile_likelihood():
+    """Two starts find the same optimum (one compilation); the profile-likelihood 95 % interval of
+    b_Ts (the least well determined of the four here) agrees with the Gauss-Newton interval to
+    within a factor 2 in width: with 1 % noise the loss is close to quadratic over +-2 se, so the
+    two must be close; a wrong s^2 or delta scaling would be off by orders of magnitude."""
+    data = generate_data(TRUE, _start(TRUE), 0.5, rate=100, kinds=("omega",), noise=0.01, seed=3)
+    best, summ = F.multistart(data, PAPER, [{}, {"mu": 0.28, "k_r": 0.3}], free=FREE, optimiser="lm", max_iter=60)
+    assert summ["n_at_best"] == 2, summ
+    for n in FREE:
+        lo, hi = summ["spread"][n]
+        assert hi - lo <= 1e-4 * best.stderr[n] + 1e-12 * abs(best.values[n])
+    v, se = best.values["b_Ts"], best.stderr["b_Ts"]
+    prof = F.profile_likelihood(data, best, "b_Ts", v + se * np.linspace(-3, 3, 7), optimiser="lm", max_iter=60)
+    lo, hi = prof["interval"]
+    assert lo < v < hi
+    glo, ghi = prof["ci95_gauss_newton"]
+    assert 0.5 < (hi - lo) / (ghi - glo) < 2.0, prof
