@@ -77,6 +77,7 @@ def main(argv=None) -> int:
     ap.add_argument("--optimisers", nargs="+", default=["lm", "lbfgs", "adam"])
     ap.add_argument("--max-iter", type=int, default=300)
     ap.add_argument("--cache", action="store_true", help="also LM with the persistent compilation cache")
+    ap.add_argument("--resume", action="store_true", help="keep the runs already in --out")
     ap.add_argument("--out", type=Path, default=Path("docs/fit/bench_fit.json"))
     ap.add_argument("--child", nargs=2, metavar=("OPTIMISER", "CACHE"), help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
@@ -107,8 +108,13 @@ def main(argv=None) -> int:
     )
     print(meta, flush=True)
     rows = []
-    runs = [(o, "-") for o in a.optimisers]
-    if a.cache:
+    if a.resume and a.out.exists():  # results are written after every run; --resume keeps them
+        prev = json.loads(a.out.read_text())
+        rows = prev["rows"]
+        meta["uptime_before"] = prev["uptime_before"]
+    done = {(r["optimiser"], r["persistent_cache"]) for r in rows}
+    runs = [(o, "-") for o in a.optimisers if (o, False) not in done]
+    if a.cache and not any(r["persistent_cache"] for r in rows):
         d = tempfile.mkdtemp(prefix="jaxcelt-xla-")
         runs += [("lm", d), ("lm", d)]
     for opt, cache in runs:
@@ -121,6 +127,10 @@ def main(argv=None) -> int:
             r["uptime_after"] = uptime()
             print(r, flush=True)
         rows += got
+        for r in got:
+            r["max_iter"] = a.max_iter
+        a.out.parent.mkdir(parents=True, exist_ok=True)
+        a.out.write_text(json.dumps(meta | {"rows": rows}, indent=1))
     meta["uptime_after"] = uptime()
     load = float(meta["uptime_after"].split("load average:")[1].split(",")[0])
     meta["loaded"] = load > 1.5

@@ -794,7 +794,7 @@ def fit(
         R, K, _ = prob.rec.ts.shape
         n_data -= int(sum(float(jnp.sum(prob.rec.mask[k][:, 1:, 0])) * OBSERVABLES[k] for k in prob.kinds))
     if uncertainty:
-        r, Jflat = (np.asarray(a) for a in _value_and_jacobian(prob, zf))
+        r, Jflat = _host_vj(np.asarray(zf))  # the optimisers' own compiled evaluation
     else:
         r = np.asarray(_residuals(prob, z)[0])
     nm = prob.n_misfit
