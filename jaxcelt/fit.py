@@ -547,13 +547,19 @@ _ACTIVE: list = [None]  # the problem the callbacks evaluate (set by `fit`; not 
 
 def _host_vj(zf):
     _CALLS[0] += 1
-    r, J = _value_and_jacobian(_ACTIVE[0], jnp.asarray(zf))
+    # one input type (a fresh array from numpy) for every caller: the jit cache hits
+    r, J = _value_and_jacobian(_ACTIVE[0], jnp.asarray(np.asarray(zf, np.float64)))
     return np.asarray(r), np.asarray(J)
 
 
 def _vj(zf: Array, m: int) -> tuple[Array, Array]:
     shapes = (jax.ShapeDtypeStruct((m,), zf.dtype), jax.ShapeDtypeStruct((m, zf.shape[-1]), zf.dtype))
     return jax.pure_callback(_host_vj, shapes, zf, vmap_method="sequential")
+
+
+@eqx.filter_jit
+def _vj_jit(zf, m):
+    return _vj(zf, m)
 
 
 def _residual_fn(m: int):
@@ -631,9 +637,9 @@ def _lsq_step(z, state, solver, m):
 
 
 @eqx.filter_jit
-def _optax_step(z, opt_state, optimiser, m):
+def _optax_step(z, opt_state, optimiser, m, linesearch: bool):
     loss_fn = _loss_fn(m)
-    if isinstance(optimiser, optax.GradientTransformationExtraArgs):  # L-BFGS: value/grad kept by its line search
+    if linesearch:  # L-BFGS: value and gradient kept in the state by its line search
         value, grad = optax.value_and_grad_from_state(loss_fn)(z, state=opt_state)
         updates, opt_state = optimiser.update(grad, opt_state, z, value=value, grad=grad, value_fn=loss_fn)
     else:
@@ -764,7 +770,7 @@ def fit(
         opt_state = opt.init(zf)
         g0 = None
         for it in range(max_iter):
-            z_new, opt_state, value, gnorm = _optax_step(zf, opt_state, opt, m)
+            z_new, opt_state, value, gnorm = _optax_step(zf, opt_state, opt, m, optimiser == "lbfgs")
             jax.block_until_ready(z_new)
             iter_marks.append(time.perf_counter())
             loss_hist.append(float(value))
@@ -794,7 +800,9 @@ def fit(
         R, K, _ = prob.rec.ts.shape
         n_data -= int(sum(float(jnp.sum(prob.rec.mask[k][:, 1:, 0])) * OBSERVABLES[k] for k in prob.kinds))
     if uncertainty:
-        r, Jflat = _host_vj(np.asarray(zf))  # the optimisers' own compiled evaluation
+        # through the callback like the optimisers: called from this thread, the jit cache of
+        # `_value_and_jacobian` misses (measured: the solve was traced and compiled again)
+        r, Jflat = (np.asarray(a) for a in _vj_jit(zf, m))
     else:
         r = np.asarray(_residuals(prob, z)[0])
     nm = prob.n_misfit
