@@ -1,6 +1,7 @@
-"""``jaxcelt fit data.npz ...``: identify contact parameters from a measured-data file.
+"""``jaxcelt fit data.npz ...`` or ``jaxcelt fit rec1.csv rec2.csv --guess mu=0.2``: identify
+contact parameters from measured records.
 
-A thin layer over `jaxcelt.fit` and `jaxcelt.data.load_data`: parses options, shows a progress
+A thin layer over `jaxcelt.fit` and `jaxcelt.data.load_data` / `load_csv`: parses options, shows a progress
 bar with the loss, prints the fitted values with 95% intervals, writes a JSON result and figures.
 """
 
