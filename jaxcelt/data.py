@@ -55,6 +55,10 @@ __all__ = [
     "generate_data",
     "save_data",
     "load_data",
+    "from_arrays",
+    "save_csv",
+    "load_csv",
+    "CSV_COLUMNS",
 ]
 
 FORMAT = "jaxcelt-measured-data"
@@ -298,3 +302,126 @@ def load_data(path: str | Path) -> MeasuredData:
         return _from_arrays(lambda k: ds[k].values)
     with np.load(path, allow_pickle=False) as f:
         return _from_arrays(lambda k: f[k])
+
+
+# ----------------------------------------------------------------------------- arrays and CSV
+CSV_COLUMNS: dict[str, tuple[str, ...]] = {
+    "omega": ("omega1", "omega2", "omega3"),
+    "orientation": ("n1", "n2", "n3", "psi"),
+    "centre": ("x_O", "y_O", "z_O"),
+    "state": tuple(f"y{i}" for i in range(13)),
+}
+"""CSV column names per observation kind (units: omega [rad/s] in body axes, n [-], psi [rad],
+centre [m], state as MODEL.md section 8)."""
+
+
+def from_arrays(
+    t,
+    *,
+    omega_pi: float,
+    q_pi: float,
+    sigma: dict[str, Sequence[float] | float] | None = None,
+    y0=None,
+    **obs,
+) -> Trajectory:
+    """One record from plain arrays, as measured data arrive.
+
+    Args:
+        t: (T,) sample times [s], increasing.
+        omega_pi: base angular frequency [rad/s]; q_pi: base amplitude [m] of this record.
+        sigma: per kind, the standard deviation of each channel (a scalar applies to all channels);
+            default 1 % of the channel's RMS (a weight only: with real noise, s^2 rescales it).
+        y0: (13,) release state if known, else None (then fit with ``fit_y0=True`` and a guess).
+        **obs: observations by kind, e.g. ``omega=(T, 3)`` array [rad/s, body axes],
+            ``orientation=(T, 4)``, ``centre=(T, 3)``, ``state=(T, 13)``.
+    """
+    if not obs:
+        raise ValueError(f"from_arrays: pass at least one observation ({', '.join(OBSERVABLES)})")
+    sigma = dict(sigma or {})
+    o, sg = {}, {}
+    for kind, x in obs.items():
+        if kind not in OBSERVABLES:
+            raise ValueError(f"from_arrays: unknown observation kind {kind!r}; known: {sorted(OBSERVABLES)}")
+        x = np.asarray(x, float)
+        if not np.all(np.isfinite(x)):
+            raise ValueError(f"from_arrays: {kind!r} contains non-finite values")
+        o[kind] = x
+        if kind in sigma:
+            sg[kind] = np.broadcast_to(np.asarray(sigma[kind], float), (OBSERVABLES[kind],)).copy()
+        else:
+            rms = np.sqrt(np.mean(x**2, axis=0)) if x.ndim == 2 else np.ones(OBSERVABLES[kind])
+            sg[kind] = 0.01 * np.maximum(rms, 1e-6 * max(float(np.max(rms)), 1e-300))
+    return Trajectory(
+        ts=np.asarray(t, float),
+        obs=o,
+        sigma=sg,
+        omega_pi=float(omega_pi),
+        q_pi=float(q_pi),
+        y0=None if y0 is None else np.asarray(y0, float),
+    )
+
+
+def save_csv(tr: Trajectory, path: str | Path) -> Path:
+    """Write one record as CSV (format: `load_csv`)."""
+    path = Path(path)
+    head = [f"# omega_pi = {tr.omega_pi!r}", f"# q_pi = {tr.q_pi!r}"]
+    if tr.y0 is not None:
+        head.append("# y0 = " + ",".join(repr(float(v)) for v in tr.y0))
+    for k in tr.kinds:
+        head.append(f"# sigma_{k} = " + ",".join(repr(float(v)) for v in tr.sigma[k]))
+    cols = ["t"] + [c for k in tr.kinds for c in CSV_COLUMNS[k]]
+    table = np.column_stack([tr.ts] + [tr.obs[k] for k in tr.kinds])
+    with open(path, "w") as f:
+        f.write("\n".join(head) + "\n" + ",".join(cols) + "\n")
+        np.savetxt(f, table, delimiter=",", fmt="%.17g")
+    return path
+
+
+def load_csv(path: str | Path, *, omega_pi: float | None = None, q_pi: float | None = None) -> Trajectory:
+    """Read one record from a CSV file.
+
+    Format: optional comment lines ``# name = value`` (``omega_pi`` [rad/s], ``q_pi`` [m],
+    ``y0`` = 13 comma-separated numbers, ``sigma_<kind>`` = one number per channel), then a header
+    row with ``t`` [s] and the columns of any kinds of `CSV_COLUMNS` (all columns of a kind), then
+    one row per sample. ``omega_pi``/``q_pi`` arguments override the file's values; one of the
+    two is required.
+    """
+    path = Path(path)
+    meta, header = {}, None
+    with open(path) as f:
+        for n_skip, line in enumerate(f):  # noqa: B007
+            s = line.strip()
+            if s.startswith("#"):
+                if "=" in s:
+                    k, v = s[1:].split("=", 1)
+                    meta[k.strip()] = v.strip()
+                continue
+            header = [c.strip() for c in s.split(",")]
+            break
+    if header is None or "t" not in header:
+        raise ValueError(f"load_csv: {path}: no header row with a 't' column")
+    table = np.loadtxt(path, delimiter=",", comments="#", skiprows=n_skip + 1, ndmin=2)
+    if table.shape[1] != len(header):
+        raise ValueError(f"load_csv: {path}: {table.shape[1]} values per row but {len(header)} columns in the header")
+    col = {c: table[:, i] for i, c in enumerate(header)}
+    obs = {}
+    for kind, names in CSV_COLUMNS.items():
+        present = [c in col for c in names]
+        if any(present) and not all(present):
+            raise ValueError(f"load_csv: {path}: kind {kind!r} needs all of the columns {names}")
+        if all(present):
+            obs[kind] = np.column_stack([col[c] for c in names])
+    unknown = set(header) - {"t"} - {c for names in CSV_COLUMNS.values() for c in names}
+    if unknown:
+        raise ValueError(f"load_csv: {path}: unknown columns {sorted(unknown)}; known: t and {CSV_COLUMNS}")
+
+    def num(name, given):
+        if given is not None:
+            return float(given)
+        if name not in meta:
+            raise ValueError(f"load_csv: {path}: {name!r} not in the file; pass {name}=...")
+        return float(meta[name])
+
+    sigma = {k: [float(v) for v in meta[f"sigma_{k}"].split(",")] for k in obs if f"sigma_{k}" in meta}
+    y0 = [float(v) for v in meta["y0"].split(",")] if "y0" in meta else None
+    return from_arrays(col["t"], omega_pi=num("omega_pi", omega_pi), q_pi=num("q_pi", q_pi), sigma=sigma, y0=y0, **obs)

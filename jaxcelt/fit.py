@@ -16,8 +16,9 @@ Residuals r(z) (all dimensionless, stacked into one vector):
 
 loss = 1/2 |r|^2. Optimisers: ``"lm"`` (optimistix Levenberg-Marquardt, forward-mode Jacobians via
 ``diffrax.ForwardMode``), ``"gn"`` (optimistix Gauss-Newton), ``"gn-damped"`` (Gauss-Newton with a
-backtracking Armijo line search), ``"adam"`` and ``"lbfgs"`` (optax,
-reverse-mode gradients). Uncertainty (`FitResult.stderr`, ``ci95``, ``corr``): the Gauss-Newton
+backtracking Armijo line search), ``"adam"`` and ``"lbfgs"`` (optax; gradient J^T r from the same
+forward-mode Jacobian). One program per problem shape holds the ODE solves (every record, padded
+to a common length, in one `jax.lax.map`); the optimisers call it through `jax.pure_callback`. Uncertainty (`FitResult.stderr`, ``ci95``, ``corr``): the Gauss-Newton
 approximation cov(z) = s^2 (J^T J)^-1 at the optimum with s^2 = RSS_misfit / (n_data - n_unknowns),
 marginalised over the window states, mapped to the physical parameters by the delta method.
 
@@ -63,6 +64,8 @@ __all__ = [
     "predict",
     "finite_time_lyapunov",
     "gradient_norm_vs_window",
+    "multistart",
+    "profile_likelihood",
 ]
 
 OPTIMISERS = ("lm", "gn", "gn-damped", "adam", "lbfgs")
@@ -155,14 +158,17 @@ def project_state(y: State, params: CeltParams) -> State:
 
 # ----------------------------------------------------------------------------- the problem
 class _Record(eqx.Module):
-    """One trajectory cut into K windows of n+1 samples (shared boundary samples)."""
+    """All R trajectories, each cut into K windows of n+1 samples (shared boundary samples), stacked
+    on a leading record axis and padded to a common n (padded samples have mask 0 and repeat the
+    window's last time), so that one vmapped program serves every record."""
 
-    ts: Array  # (K, n+1)
-    obs: dict  # kind -> (K, n+1, k)
-    inv_sigma: dict  # kind -> (k,)
-    fixed_states: Array  # (K, 13) states of windows that are not optimised
-    omega_pi: Array
-    q_pi: Array
+    ts: Array  # (R, K, n+1)
+    obs: dict  # kind -> (R, K, n+1, k)
+    mask: dict  # kind -> (R, K, n+1): 1 for a measured sample, 0 for padding or a missing kind
+    inv_sigma: dict  # kind -> (R, k)
+    fixed_states: Array  # (R, K, 13) states of windows that are not optimised
+    omega_pi: Array  # (R,)
+    q_pi: Array  # (R,)
     free_windows: tuple[int, ...] = eqx.field(static=True)
 
 
@@ -171,7 +177,7 @@ class _Problem(eqx.Module):
 
     params0: CeltParams
     theta0: Array  # (P,)
-    records: tuple[_Record, ...]
+    rec: _Record
     weights: dict  # kind -> scalar
     continuity_weight: Array
     free: tuple[str, ...] = eqx.field(static=True)
@@ -182,6 +188,10 @@ class _Problem(eqx.Module):
     atol: float = eqx.field(static=True)
     max_steps: int = eqx.field(static=True)
 
+    @property
+    def n_records(self) -> int:
+        return int(self.rec.ts.shape[0])
+
     def theta(self, zp: Array) -> Array:
         return jnp.stack([tr.forward(zp[i], self.theta0[i]) for i, tr in enumerate(self.transforms)])
 
@@ -190,28 +200,26 @@ class _Problem(eqx.Module):
         names = self.free
         return eqx.tree_at(lambda p: [getattr(p, n) for n in names], self.params0, [th[i] for i in range(len(names))])
 
-    def window_states(self, z, i: int) -> Array:
-        rec = self.records[i]
-        s = rec.fixed_states
-        if rec.free_windows:
-            s = s.at[jnp.array(rec.free_windows)].set(z["states"][i] * STATE_SCALE[None, :])
-        return s
+    def _record_params(self, p: CeltParams, omega_pi, q_pi) -> CeltParams:
+        return eqx.tree_at(lambda q: (q.omega_pi, q.q_pi), p, (omega_pi, q_pi))
 
-    def simulate_windows(self, z, i: int) -> tuple[Array, Array]:
-        """States (K, n+1, 13) in every window of record i, and the solver status (K,)."""
-        rec = self.records[i]
-        p = self.params(z["params"])
-        p = eqx.tree_at(lambda q: (q.omega_pi, q.q_pi), p, (rec.omega_pi, rec.q_pi))
-        s = jax.vmap(lambda y: project_state(y, p))(self.window_states(z, i))
+    def _window_states(self, zs: Array, fixed: Array) -> Array:
+        """Window initial states (K, 13) of one record from its optimised states zs (k, 13)."""
+        if self.rec.free_windows:
+            return fixed.at[jnp.array(self.rec.free_windows)].set(zs * STATE_SCALE[None, :])
+        return fixed
+
+    def _simulate_record(self, p, zs, fixed, ts) -> tuple[Array, Array]:
+        s = jax.vmap(lambda y: project_state(y, p))(self._window_states(zs, fixed))
         adjoint = diffrax.ForwardMode() if self.mode == "fwd" else diffrax.RecursiveCheckpointAdjoint()
 
-        def one(y0, ts):
+        def one(y0, t):
             sol = simulate(
                 p,
                 y0,
-                ts[-1],
-                t0=ts[0],
-                ts=ts,
+                t[-1],
+                t0=t[0],
+                ts=t,
                 rtol=self.rtol,
                 atol=self.atol,
                 max_steps=self.max_steps,
@@ -219,71 +227,92 @@ class _Problem(eqx.Module):
             )
             return sol.ys, sol.status
 
-        return jax.vmap(one)(s, rec.ts)
+        return jax.vmap(one)(s, ts)
+
+    def simulate_windows(self, z) -> tuple[Array, Array]:
+        """States (R, K, n+1, 13) in every window of every record, and the solver status (R, K)."""
+        p = self.params(z["params"])
+        rec = self.rec
+        return jax.lax.map(
+            lambda a: self._simulate_record(self._record_params(p, a[3], a[4]), a[0], a[1], a[2]),
+            (z["states"], rec.fixed_states, rec.ts, rec.omega_pi, rec.q_pi),
+        )
 
     def residuals(self, z, args=None) -> tuple[Array, dict]:
-        """(r (M,), aux) with aux = {"misfit": data-part RSS, "continuity": penalty RSS}."""
+        """(r (M,), aux) with aux = {"misfit": data-part RSS, "continuity": penalty RSS}. The first
+        `n_misfit` entries are the data residuals (padding included, as zeros), the rest penalties."""
         p = self.params(z["params"])
-        mis, pen = [], []
-        for i, rec in enumerate(self.records):
-            ys, status = self.simulate_windows(z, i)
-            pr = eqx.tree_at(lambda q: (q.omega_pi, q.q_pi), p, (rec.omega_pi, rec.q_pi))
-            for kind in rec.obs:
-                h = jax.vmap(jax.vmap(lambda y, kind=kind, pr=pr: observe(y, pr, kind)))(ys)
-                r = (h - rec.obs[kind]) * rec.inv_sigma[kind][None, None, :] * jnp.sqrt(self.weights[kind])
+        rec = self.rec
+        kinds = self.kinds
+        wts = {k: jnp.sqrt(self.weights[k]) for k in kinds}
+        cw = jnp.sqrt(self.continuity_weight)
+
+        def one(zs, fixed, ts, om, q, obs, mask, inv_sigma):
+            pr = self._record_params(p, om, q)
+            ys, _ = self._simulate_record(pr, zs, fixed, ts)
+            mis, pen = [], []
+            for kind in kinds:
+                h = jax.vmap(jax.vmap(lambda y, kind=kind: observe(y, pr, kind)))(ys)
+                r = (h - obs[kind]) * inv_sigma[kind][None, None, :] * wts[kind] * mask[kind][..., None]
                 # window k>0 starts at the previous window's last sample: count it once
                 mis.append(jnp.concatenate([r[0].reshape(-1), r[1:, 1:].reshape(-1)]))
-            K = ys.shape[0]
-            if K > 1:
-                starts = jax.vmap(lambda y, pr=pr: project_state(y, pr))(self.window_states(z, i))
+            if ys.shape[0] > 1:
+                starts = jax.vmap(lambda y: project_state(y, pr))(self._window_states(zs, fixed))
                 c = (ys[:-1, -1] - starts[1:]) / STATE_SCALE[None, :]
-                pen.append(c.reshape(-1) * jnp.sqrt(self.continuity_weight))
+                pen.append(c.reshape(-1) * cw)
             if rec.free_windows:
-                raw = z["states"][i] * STATE_SCALE[None, :]
-                g = (raw - jax.vmap(lambda y, pr=pr: project_state(y, pr))(raw)) / STATE_SCALE[None, :]
-                pen.append(g.reshape(-1) * jnp.sqrt(self.continuity_weight))
-        rm = jnp.concatenate(mis)
-        rp = jnp.concatenate(pen) if pen else jnp.zeros(0)
+                raw = zs * STATE_SCALE[None, :]
+                g = (raw - jax.vmap(lambda y: project_state(y, pr))(raw)) / STATE_SCALE[None, :]
+                pen.append(g.reshape(-1) * cw)
+            return jnp.concatenate(mis), (jnp.concatenate(pen) if pen else jnp.zeros(0))
+
+        # records one after another in one traced body (lax.map): on CPU a vmapped adaptive solve
+        # steps every lane until the slowest is done, at several times the cost of a sequence
+        rm, rp = jax.lax.map(
+            lambda a: one(*a),
+            (z["states"], rec.fixed_states, rec.ts, rec.omega_pi, rec.q_pi, rec.obs, rec.mask, rec.inv_sigma),
+        )
+        rm, rp = rm.reshape(-1), rp.reshape(-1)
         # a failed or diverging solve gives inf/NaN samples: a large finite residual lets the
         # optimiser reject the step instead of poisoning its state
         rm = jnp.where(jnp.isfinite(rm), rm, 1e6)
         rp = jnp.where(jnp.isfinite(rp), rp, 1e6)
         return jnp.concatenate([rm, rp]), {"misfit": jnp.sum(rm**2), "continuity": jnp.sum(rp**2)}
 
+    @property
+    def n_misfit(self) -> int:
+        """Length of the data part of the residual vector (padding included)."""
+        R, K, n1 = self.rec.ts.shape
+        return R * (n1 + (K - 1) * (n1 - 1)) * sum(self.rec.obs[k].shape[-1] for k in self.kinds)
+
+    @property
+    def n_residuals(self) -> int:
+        """Length M of the residual vector: data part, then continuity and gauge penalties."""
+        R, K, _ = self.rec.ts.shape
+        return self.n_misfit + R * 13 * ((K - 1 if K > 1 else 0) + len(self.rec.free_windows))
+
     def loss(self, z) -> Array:
         return 0.5 * jnp.sum(self.residuals(z)[0] ** 2)
 
-    # -- flat interface for the least-squares solvers ---------------------------------------
+    # -- flat interface for the optimisers ---------------------------------------------------
     def unflatten(self, zf: Array) -> dict:
         P = len(self.free)
-        states, i = [], P
-        for rec in self.records:
-            k = len(rec.free_windows)
-            states.append(zf[i : i + 13 * k].reshape(k, 13))
-            i += 13 * k
-        return {"params": zf[:P], "states": tuple(states)}
+        R = self.n_records
+        k = len(self.rec.free_windows)
+        return {"params": zf[:P], "states": zf[P:].reshape(R, k, 13)}
+
+    def flatten(self, z: dict) -> Array:
+        return jnp.concatenate([z["params"], z["states"].reshape(-1)])
 
     def value_and_jacobian(self, zf: Array) -> tuple[Array, Array]:
         """r (M,) and the forward-mode Jacobian dr/dz (M, len(zf)) in one batched JVP pass."""
-        f = lambda x: self.residuals(self.unflatten(x))[0]
-        J, r = jax.jacfwd(lambda x: (f(x), f(x)), has_aux=True)(zf)
+
+        def f(x):
+            r = self.residuals(self.unflatten(x))[0]
+            return r, r
+
+        J, r = jax.jacfwd(f, has_aux=True)(zf)
         return r, J
-
-    def flat_residuals(self, zf: Array, args=None) -> Array:
-        """r(z) for optimistix. Its JVP is J dz with J from `value_and_jacobian`, so that the
-        solver's linearisation costs one batched forward pass per iteration instead of one
-        re-simulation per materialised column."""
-
-        @jax.custom_jvp
-        def res(x):
-            return self.residuals(self.unflatten(x))[0]
-
-        @res.defjvp
-        def res_jvp(primals, tangents):
-            r, J = self.value_and_jacobian(primals[0])
-            return r, J @ tangents[0]
-
-        return res(zf)
 
 
 # ----------------------------------------------------------------------------- result
@@ -296,7 +325,7 @@ class FitResult:
     corr (P, P): correlation matrix of the free parameters; s2: residual variance factor;
     loss_history, param_history (iteration -> loss, dict of values); wall_time [s] of the
     optimisation after compilation, compile_time [s] of the first iteration, total_time [s];
-    n_iter; converged: the optimiser's own criterion (LM/GN) or the loss/step criterion (optax).
+    n_iter; converged: the optimiser's own criterion (LM/GN) or the gradient-norm test (optax, ``gtol``).
     z: final unknowns; problem: the residual function (for `predict`, plotting).
     """
 
@@ -403,7 +432,7 @@ def _build(
         raise ValueError(f"fit: window_states must be 'data' or 'optimise', got {window_states!r}")
     theta0 = jnp.stack([jnp.asarray(getattr(params0, n), float) for n in free])
     kinds_all: set[str] = set()
-    records, z_states = [], []
+    per = []
     for it, tr in enumerate(data.trajectories):
         T = tr.ts.size
         n = (T - 1) // windows
@@ -440,41 +469,59 @@ def _build(
                     atol=atol,
                 )
                 starts[1:] = np.asarray(sol.ys)[1:]
-        free_w = []
-        if fit_y0:
-            free_w.append(0)
-        if windows > 1 and window_states == "optimise":
-            free_w += list(range(1, windows))
         fixed = np.where(np.isnan(starts), 0.0, starts)
-        records.append(
-            _Record(
-                ts=jnp.asarray(tr.ts[idx]),
-                obs={k: jnp.asarray(tr.obs[k][idx]) for k in tr.kinds},
-                inv_sigma={k: jnp.asarray(1.0 / tr.sigma[k]) for k in tr.kinds},
-                fixed_states=jnp.asarray(fixed),
-                omega_pi=jnp.asarray(tr.omega_pi),
-                q_pi=jnp.asarray(tr.q_pi),
-                free_windows=tuple(free_w),
-            )
-        )
-        z_states.append(jnp.asarray(fixed[free_w] / STATE_SCALE) if free_w else jnp.zeros((0, 13)))
+        per.append((tr, idx, fixed))
         kinds_all |= set(tr.kinds)
-    w = {k: jnp.asarray(float(weights.get(k, 1.0))) for k in sorted(kinds_all)}
+    free_w = []
+    if fit_y0:
+        free_w.append(0)
+    if windows > 1 and window_states == "optimise":
+        free_w += list(range(1, windows))
+    kinds = tuple(sorted(kinds_all))
+    # stack the records, padded to the longest window (n1 samples per window)
+    R, n1 = len(per), max(idx.shape[1] for _, idx, _ in per)
+    ts = np.zeros((R, windows, n1))
+    obs = {k: np.zeros((R, windows, n1, OBSERVABLES[k])) for k in kinds}
+    mask = {k: np.zeros((R, windows, n1)) for k in kinds}
+    inv_sigma = {k: np.ones((R, OBSERVABLES[k])) for k in kinds}
+    for r, (tr, idx, _) in enumerate(per):
+        m = idx.shape[1]
+        ts[r, :, :m] = tr.ts[idx]
+        ts[r, :, m:] = tr.ts[idx[:, -1:]]  # padding repeats the window's last time
+        for k in tr.kinds:
+            obs[k][r, :, :m] = tr.obs[k][idx]
+            mask[k][r, :, :m] = 1.0
+            inv_sigma[k][r] = 1.0 / tr.sigma[k]
+        if m < n1 and windows > 1:
+            raise ValueError("fit: multiple shooting needs records of equal length (pad or cut them)")
+    fixed = np.stack([f for _, _, f in per])
+    rec = _Record(
+        ts=jnp.asarray(ts),
+        obs={k: jnp.asarray(v) for k, v in obs.items()},
+        mask={k: jnp.asarray(v) for k, v in mask.items()},
+        inv_sigma={k: jnp.asarray(v) for k, v in inv_sigma.items()},
+        fixed_states=jnp.asarray(fixed),
+        omega_pi=jnp.asarray([tr.omega_pi for tr, _, _ in per], float),
+        q_pi=jnp.asarray([tr.q_pi for tr, _, _ in per], float),
+        free_windows=tuple(free_w),
+    )
+    z_states = jnp.asarray(fixed[:, free_w] / STATE_SCALE) if free_w else jnp.zeros((R, 0, 13))
+    w = {k: jnp.asarray(float(weights.get(k, 1.0))) for k in kinds}
     prob = _Problem(
         params0=params0,
         theta0=theta0,
-        records=tuple(records),
+        rec=rec,
         weights=w,
         continuity_weight=jnp.asarray(float(continuity_weight)),
         free=tuple(free),
         transforms=tuple(trs),
-        kinds=tuple(sorted(kinds_all)),
+        kinds=kinds,
         mode=mode,
         rtol=rtol,
         atol=atol,
         max_steps=max_steps,
     )
-    z0 = {"params": jnp.zeros(len(free)), "states": tuple(z_states)}
+    z0 = {"params": jnp.zeros(len(free)), "states": z_states}
     return prob, z0
 
 
@@ -489,11 +536,61 @@ def _value_and_jacobian(prob: _Problem, zf):
     return dataclasses.replace(prob, mode="fwd").value_and_jacobian(zf)
 
 
+# The only program that contains the ODE solver is `_value_and_jacobian` (residuals and their
+# forward-mode Jacobian, all records vmapped): compiled once per problem shape and shared by every
+# optimiser, the uncertainty, multi-start and profile likelihood. The optimisers' own (small)
+# programs reach it through `jax.pure_callback`, so they never contain the solver and are compiled
+# in about a second, once per (residual length, unknowns, optimiser) for the whole process.
+_CALLS = [0]  # evaluations of (r, J) (reported as FitResult.n_eval)
+_ACTIVE: list = [None]  # the problem the callbacks evaluate (set by `fit`; not thread-safe)
+
+
+def _host_vj(zf):
+    _CALLS[0] += 1
+    # one input type (a fresh array from numpy) for every caller: the jit cache hits
+    r, J = _value_and_jacobian(_ACTIVE[0], jnp.asarray(np.asarray(zf, np.float64)))
+    return np.asarray(r), np.asarray(J)
+
+
+def _vj(zf: Array, m: int) -> tuple[Array, Array]:
+    shapes = (jax.ShapeDtypeStruct((m,), zf.dtype), jax.ShapeDtypeStruct((m, zf.shape[-1]), zf.dtype))
+    return jax.pure_callback(_host_vj, shapes, zf, vmap_method="sequential")
+
+
 @eqx.filter_jit
-def _lsq_jac(state):
-    # Jacobian at the last accepted iterate, kept by optimistix as a linear operator (with the
-    # custom JVP of `_Problem.flat_residuals` it is J @ dz, so materialising it is cheap)
-    return state.f_info.jac.as_matrix()
+def _vj_jit(zf, m):
+    return _vj(zf, m)
+
+
+def _residual_fn(m: int):
+    """z -> r(z) with the JVP J dz, both from one callback evaluation."""
+
+    @jax.custom_jvp
+    def res(x):
+        return _vj(x, m)[0]
+
+    @res.defjvp
+    def res_jvp(primals, tangents):
+        r, J = _vj(primals[0], m)
+        return r, J @ tangents[0]
+
+    return res
+
+
+def _loss_fn(m: int):
+    """z -> 1/2 |r|^2 with the gradient J^T r (forward-mode J; reverse mode differentiates the JVP)."""
+
+    @jax.custom_jvp
+    def loss(x):
+        r = _vj(x, m)[0]
+        return 0.5 * jnp.sum(r**2)
+
+    @loss.defjvp
+    def loss_jvp(primals, tangents):
+        r, J = _vj(primals[0], m)
+        return 0.5 * jnp.sum(r**2), jnp.dot(J.T @ r, tangents[0])
+
+    return loss
 
 
 class DampedGaussNewton(optx.AbstractGaussNewton):
@@ -518,20 +615,21 @@ def _lsq_solver(name, rtol, atol):
     return optx.GaussNewton(rtol=rtol, atol=atol)
 
 
-def _lsq_fn(prob):
-    return lambda zf, args: (prob.flat_residuals(zf), None)
+def _lsq_fn(m):
+    res = _residual_fn(m)
+    return lambda zf, args: (res(zf), None)
 
 
 @eqx.filter_jit
-def _lsq_init(prob, z, solver):
-    fn = _lsq_fn(prob)
-    f_struct, aux_struct = jax.eval_shape(fn, z, None)
-    return solver.init(fn, z, None, {}, f_struct, aux_struct, frozenset())
+def _lsq_init(z, solver, m):
+    fn = _lsq_fn(m)
+    f_struct = jax.ShapeDtypeStruct((m,), z.dtype)
+    return solver.init(fn, z, None, {}, f_struct, None, frozenset())
 
 
 @eqx.filter_jit
-def _lsq_step(prob, z, state, solver):
-    fn = _lsq_fn(prob)
+def _lsq_step(z, state, solver, m):
+    fn = _lsq_fn(m)
     z, state, _ = solver.step(fn, z, None, {}, state, frozenset())
     done, result = solver.terminate(fn, z, None, {}, state, frozenset())
     # loss at the last accepted iterate
@@ -539,15 +637,16 @@ def _lsq_step(prob, z, state, solver):
 
 
 @eqx.filter_jit
-def _optax_step(prob, z, opt_state, optimiser):
-    loss_fn = prob.loss
-    value, grad = jax.value_and_grad(loss_fn)(z)
-    if isinstance(optimiser, optax.GradientTransformationExtraArgs):
+def _optax_step(z, opt_state, optimiser, m, linesearch: bool):
+    loss_fn = _loss_fn(m)
+    if linesearch:  # L-BFGS: value and gradient kept in the state by its line search
+        value, grad = optax.value_and_grad_from_state(loss_fn)(z, state=opt_state)
         updates, opt_state = optimiser.update(grad, opt_state, z, value=value, grad=grad, value_fn=loss_fn)
     else:
+        value, grad = jax.value_and_grad(loss_fn)(z)
         updates, opt_state = optimiser.update(grad, opt_state, z)
     z_new = optax.apply_updates(z, updates)
-    return z_new, opt_state, value, optax.tree.norm(grad)
+    return z_new, opt_state, value, jnp.linalg.norm(grad)
 
 
 def fit(
@@ -567,8 +666,9 @@ def fit(
     atol: float = 1e-8,
     sim_rtol: float = 1e-8,
     sim_atol: float = 1e-10,
-    max_steps: int = 200_000,
+    max_steps: int = 10_000,
     learning_rate: float = 0.02,
+    gtol: float = 1e-9,
     uncertainty: bool = True,
     max_time: float | None = None,
     callback: Callable[[int, float, dict[str, float]], None] | None = None,
@@ -583,7 +683,8 @@ def fit(
             reading switches and the per-record omega_pi, q_pi).
         optimiser: ``"lm"`` (optimistix Levenberg-Marquardt), ``"gn"`` (plain Gauss-Newton, full
             steps), ``"gn-damped"`` (Gauss-Newton with a backtracking line search), all with
-            forward-mode Jacobians; ``"adam"`` or ``"lbfgs"`` (optax, reverse-mode gradients).
+            forward-mode Jacobians; ``"adam"`` (cosine-decayed step) or ``"lbfgs"`` (zoom line
+            search), optax, with the gradient J^T r from the same forward-mode Jacobian.
         weights: extra weight per observation kind (default 1; residuals are already /sigma).
         transforms: per-parameter transforms overriding `DEFAULT_TRANSFORMS` (else `Positive`).
         windows: number of multiple-shooting windows per record (1 = single shooting).
@@ -595,10 +696,12 @@ def fit(
         continuity_weight: weight of the continuity and gauge residuals (residual scale
             `STATE_SCALE` / sqrt(weight)).
         max_iter: iteration budget. rtol, atol: optimistix termination (relative/absolute change
-            of z and of the loss); optax optimisers stop when the relative loss change < rtol
-            over 5 iterations.
-        sim_rtol, sim_atol, max_steps: integrator settings.
-        learning_rate: Adam step size in z (log-relative units for `Positive` parameters).
+            of z and of the loss).
+        sim_rtol, sim_atol, max_steps: integrator settings (max_steps per solve: a trial step into a
+            stiff region fails fast at the cap and is rejected).
+        learning_rate: Adam initial step size in z (log-relative units for `Positive`
+            parameters), decayed by a cosine schedule to 1e-3 of it over ``max_iter``.
+        gtol: optax optimisers stop, converged, when |grad loss| <= gtol |grad loss at start|.
         uncertainty: compute standard errors, intervals and correlations.
         max_time: wall-clock budget [s] for the iterations (checked after each iteration;
             compilation included); the fit stops unconverged when it is spent.
@@ -609,7 +712,8 @@ def fit(
     """
     if optimiser not in OPTIMISERS:
         raise ValueError(f"fit: optimiser must be one of {OPTIMISERS}, got {optimiser!r}")
-    mode = "fwd" if optimiser in ("lm", "gn", "gn-damped") else "rev"
+    if isinstance(max_iter, bool) or not isinstance(max_iter, int) or max_iter < 1:
+        raise ValueError(f"fit: max_iter must be a positive int, got {max_iter!r}")
     free = tuple(free)
     prob, z = _build(
         data,
@@ -621,35 +725,34 @@ def fit(
         window_states,
         fit_y0,
         continuity_weight,
-        mode,
+        "fwd",
         sim_rtol,
         sim_atol,
         max_steps,
     )
-    t_start = time.perf_counter()  # includes _lsq_init's compilation in the first mark
+    P = len(free)
+    m = prob.n_residuals
+    _ACTIVE[0] = prob
+    t_start = time.perf_counter()
 
-    def values_of(zz) -> dict[str, float]:
-        zp = zz["params"] if isinstance(zz, dict) else zz[: len(free)]
-        th = np.asarray(prob.theta(zp))
+    def values_of(zf) -> dict[str, float]:
+        th = np.asarray(prob.theta(zf[:P]))
         return {n: float(th[i]) for i, n in enumerate(free)}
 
     loss_hist, par_hist = [], []
     converged = False
-    lsq_state = None
     iter_marks = [time.perf_counter()]
-    compile_time = 0.0
-    if mode == "fwd":
-        z = jnp.concatenate([z["params"], *[s.reshape(-1) for s in z["states"]]])
+    zf = prob.flatten(z)
+    if optimiser in ("lm", "gn", "gn-damped"):
         solver = _lsq_solver(optimiser, rtol, atol)
-        state = _lsq_init(prob, z, solver)
+        state = _lsq_init(zf, solver, m)
         for it in range(max_iter):
-            z_new, state, loss_acc, done, result = _lsq_step(prob, z, state, solver)
+            z_new, state, loss_acc, done, result = _lsq_step(zf, state, solver, m)
             jax.block_until_ready(z_new)
             iter_marks.append(time.perf_counter())
-            # optimistix reports the loss of the point it evaluated; track the accepted iterate
-            z = z_new
+            zf = z_new
             loss_hist.append(float(loss_acc))
-            par_hist.append(values_of(z))
+            par_hist.append(values_of(zf))
             if callback is not None:
                 callback(it, loss_hist[-1], par_hist[-1])
             if bool(done):
@@ -657,28 +760,32 @@ def fit(
                 break
             if max_time is not None and iter_marks[-1] - t_start > max_time:
                 break
-        z = prob.unflatten(z)
-        lsq_state = state
     else:
         if optimiser == "adam":
-            opt = optax.adam(learning_rate)
+            # cosine decay to 1e-3 of the initial step over the budget: constant-step Adam hovers
+            # around the optimum at a distance ~ learning_rate instead of converging
+            opt = optax.adam(optax.cosine_decay_schedule(learning_rate, max_iter, alpha=1e-3))
         else:
             opt = optax.lbfgs()
-        opt_state = opt.init(z)
+        opt_state = opt.init(zf)
+        g0 = None
         for it in range(max_iter):
-            z_new, opt_state, value, gnorm = _optax_step(prob, z, opt_state, opt)
+            z_new, opt_state, value, gnorm = _optax_step(zf, opt_state, opt, m, optimiser == "lbfgs")
             jax.block_until_ready(z_new)
             iter_marks.append(time.perf_counter())
             loss_hist.append(float(value))
-            par_hist.append(values_of(z))
+            par_hist.append(values_of(zf))
             if callback is not None:
                 callback(it, loss_hist[-1], par_hist[-1])
-            z = z_new
+            g = float(gnorm)
+            g0 = g if g0 is None else g0
             if not np.isfinite(float(value)):
                 break
-            if it >= 5 and abs(loss_hist[-6] - loss_hist[-1]) <= rtol * abs(loss_hist[-1]) + 1e-14:
+            # gradient of the loss at zf (before the update) reduced by gtol: zf is the optimum
+            if g <= gtol * g0:
                 converged = True
                 break
+            zf = z_new
             if max_time is not None and iter_marks[-1] - t_start > max_time:
                 break
     loop_time = time.perf_counter() - t_start
@@ -687,30 +794,31 @@ def fit(
     # the first iteration pays for compilation; count it as a typical iteration in the run time
     compile_time = max(float(iter_times[0]) - typical, 0.0) if iter_times.size else 0.0
     wall = loop_time - compile_time
-    n_data = sum(_count(rec, k) for rec in prob.records for k in rec.obs)
-    zf = jnp.concatenate([z["params"], *[s.reshape(-1) for s in z["states"]]])
-    Jflat = None
-    if mode == "fwd" and lsq_state is not None:
-        r = np.asarray(lsq_state.f_info.residual)
-        if uncertainty:
-            Jflat = np.asarray(_lsq_jac(lsq_state))
-    elif uncertainty:
-        r, Jflat = (np.asarray(a) for a in _value_and_jacobian(prob, zf))
+    z = prob.unflatten(zf)
+    n_data = int(sum(float(jnp.sum(prob.rec.mask[k])) * OBSERVABLES[k] for k in prob.kinds))
+    if prob.rec.ts.shape[1] > 1:  # shared window boundary samples are counted once
+        R, K, _ = prob.rec.ts.shape
+        n_data -= int(sum(float(jnp.sum(prob.rec.mask[k][:, 1:, 0])) * OBSERVABLES[k] for k in prob.kinds))
+    if uncertainty:
+        # through the callback like the optimisers: called from this thread, the jit cache of
+        # `_value_and_jacobian` misses (measured: the solve was traced and compiled again)
+        r, Jflat = (np.asarray(a) for a in _vj_jit(zf, m))
     else:
         r = np.asarray(_residuals(prob, z)[0])
-    misfit, cont = float(np.sum(r[:n_data] ** 2)), float(np.sum(r[n_data:] ** 2))
+    nm = prob.n_misfit
+    misfit, cont = float(np.sum(r[:nm] ** 2)), float(np.sum(r[nm:] ** 2))
     loss_hist.append(0.5 * (misfit + cont))
-    par_hist.append(values_of(z))
+    par_hist.append(values_of(zf))
     n_unk = int(zf.size)
-    P = len(free)
-    values = values_of(z)
+    values = values_of(zf)
     stderr = dict.fromkeys(free, np.nan)
     ci = {n: (np.nan, np.nan) for n in free}
     cov = np.full((P, P), np.nan)
     corr = np.full((P, P), np.nan)
     s2 = np.nan
     if uncertainty:
-        dof = max(n_data - (n_unk - 3 * sum(len(rec.free_windows) for rec in prob.records)), 1)
+        n_free_states = prob.n_records * len(prob.rec.free_windows)
+        dof = max(n_data - (n_unk - 3 * n_free_states), 1)
         s2 = misfit / dof
         H = Jflat.T @ Jflat
         try:  # a fit that ended in a failing-solve region can leave a non-finite Jacobian
@@ -756,28 +864,101 @@ def fit(
     )
 
 
-def _count(rec: _Record, kind: str) -> int:
-    K, n1, k = rec.obs[kind].shape
-    return (n1 + (K - 1) * (n1 - 1)) * k
-
-
 def predict(result: FitResult) -> list[dict[str, Any]]:
     """Fitted trajectories per record: [{"ts": (K, n+1), "ys": (K, n+1, 13), kind: (K, n+1, k)}].
 
-    Windows are simulated from their fitted initial states (one window = single shooting).
+    Windows are simulated from their fitted initial states (one window = single shooting). Records
+    shorter than the longest are padded (their last sample repeated; ``"mask"`` marks real samples).
     """
     prob, z = result.problem, result.z
+    ys_all, _ = eqx.filter_jit(lambda pr, zz: pr.simulate_windows(zz))(dataclasses.replace(prob, mode="rev"), z)
     out = []
-    for i, rec in enumerate(prob.records):
-        ys, _ = eqx.filter_jit(lambda pr, zz, i=i: pr.simulate_windows(zz, i))(dataclasses.replace(prob, mode="rev"), z)
+    for i in range(prob.n_records):
+        rec = prob.rec
+        ys = ys_all[i]
         p = prob.params(z["params"])
-        p = eqx.tree_at(lambda q: (q.omega_pi, q.q_pi), p, (rec.omega_pi, rec.q_pi))
-        d = {"ts": np.asarray(rec.ts), "ys": np.asarray(ys)}
+        p = eqx.tree_at(lambda q: (q.omega_pi, q.q_pi), p, (rec.omega_pi[i], rec.q_pi[i]))
+        d = {"ts": np.asarray(rec.ts[i]), "ys": np.asarray(ys)}
         for kind in OBSERVABLES:
             d[kind] = np.asarray(jax.vmap(jax.vmap(lambda y, kind=kind, p=p: observe(y, p, kind)))(ys))
-        d["data"] = {k: np.asarray(v) for k, v in rec.obs.items()}
+        d["data"] = {k: np.asarray(v[i]) for k, v in rec.obs.items()}
+        d["mask"] = {k: np.asarray(v[i]) > 0 for k, v in rec.mask.items()}
         out.append(d)
     return out
+
+
+# ----------------------------------------------------------------------------- multi-start, profile likelihood
+def multistart(
+    data: MeasuredData, params0: CeltParams, guesses: Sequence[dict[str, float]], **fit_kw
+) -> tuple[FitResult, dict[str, Any]]:
+    """Fits from several initial guesses; returns the best (lowest loss) and a summary.
+
+    Every guess has the same problem shape, so all fits share the compiled programs of the first
+    (one compilation in total); fits run one after another. ``guesses``: dicts of starting values
+    (other parameters from ``params0``). Summary: per fit its start, values, loss, converged; and
+    per parameter the spread (min, max) over the converged fits whose loss is within 1e-6
+    relative of the best (the fits that found the same optimum) and how many did.
+    """
+    if not guesses:
+        raise ValueError("multistart: 'guesses' is empty")
+    results = [fit(data, params0.replace(**g), **fit_kw) for g in guesses]
+    best = min(results, key=lambda r: r.loss if np.isfinite(r.loss) else np.inf)
+    same = [r for r in results if r.converged and abs(r.loss - best.loss) <= 1e-6 * abs(best.loss) + 1e-12]
+    summary = dict(
+        fits=[
+            dict(start=dict(g), values=r.values, loss=r.loss, converged=r.converged, n_iter=r.n_iter)
+            for g, r in zip(guesses, results, strict=True)
+        ],
+        n_at_best=len(same),
+        spread={n: (min(r.values[n] for r in same), max(r.values[n] for r in same)) for n in best.free} if same else {},
+    )
+    return best, summary
+
+
+def profile_likelihood(
+    data: MeasuredData, result: FitResult, name: str, values: Sequence[float], **fit_kw
+) -> dict[str, Any]:
+    """Profile of the loss over one parameter: for each fixed value, the other free parameters are
+    re-fitted (started from ``result``). With Gaussian noise, 2 (loss(v) - loss_min) / s^2 is
+    asymptotically chi^2_1; the 95 % profile interval is where it stays below 3.84. Compare it with
+    the Gauss-Newton interval ``result.ci95[name]``: agreement means the quadratic (linearised)
+    picture holds; a lopsided or wider profile flags weak, nonlinear identification.
+
+    Returns dict(values, loss, delta = 2 (loss - min loss)/s^2, interval (lo, hi) from linear
+    interpolation of the 3.84 crossings (NaN where the grid does not cross), ci95_gauss_newton).
+    """
+    if name not in result.free:
+        raise ValueError(f"profile_likelihood: {name!r} is not a free parameter of the fit ({result.free})")
+    others = tuple(n for n in result.free if n != name)
+    if not others:
+        raise ValueError("profile_likelihood: needs at least two free parameters")
+    kw = dict(free=others, uncertainty=False) | fit_kw
+    losses = []
+    for v in values:
+        r = fit(data, result.params.replace(**{name: float(v)}), **kw)
+        losses.append(r.loss)
+    vals, losses = np.asarray(values, float), np.asarray(losses)
+    lmin = min(float(losses.min()), result.loss)
+    delta = 2 * (losses - lmin) / result.s2
+    lo = hi = np.nan
+    below = delta <= 3.84
+    i_best = int(np.argmin(delta))
+    for i in range(i_best, 0, -1):  # left crossing
+        if below[i] and not below[i - 1]:
+            lo = float(np.interp(3.84, [delta[i], delta[i - 1]], [vals[i], vals[i - 1]]))
+            break
+    for i in range(i_best, len(vals) - 1):  # right crossing
+        if below[i] and not below[i + 1]:
+            hi = float(np.interp(3.84, [delta[i], delta[i + 1]], [vals[i], vals[i + 1]]))
+            break
+    return dict(
+        name=name,
+        values=vals.tolist(),
+        loss=losses.tolist(),
+        delta=delta.tolist(),
+        interval=(lo, hi),
+        ci95_gauss_newton=tuple(result.ci95[name]),
+    )
 
 
 # ----------------------------------------------------------------------------- chaos diagnostics
@@ -831,9 +1012,9 @@ def gradient_norm_vs_window(
     r, J = (np.asarray(a) for a in _value_and_jacobian(prob, zf))
     n1 = len(tr.ts)
     per_sample, i = np.zeros((n1, J.shape[1])), 0
-    for _kind, ob in prob.records[0].obs.items():  # residual blocks: kind-major, then sample-major
-        m = n1 * ob.shape[-1]
-        per_sample += (r[i : i + m, None] * J[i : i + m]).reshape(n1, ob.shape[-1], -1).sum(axis=1)
+    for kind in prob.kinds:  # residual blocks: kind-major, then sample-major
+        m = n1 * OBSERVABLES[kind]
+        per_sample += (r[i : i + m, None] * J[i : i + m]).reshape(n1, OBSERVABLES[kind], -1).sum(axis=1)
         i += m
     g = np.cumsum(per_sample, axis=0)  # (n1, P): gradient of the loss on samples 0..L
     lengths = np.arange(1, n1) if lengths is None else np.asarray(lengths)

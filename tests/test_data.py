@@ -108,3 +108,27 @@ def test_trajectory_validation(clean):
     with pytest.raises(ValueError, match="not in the record"):
         tr.subset(["omega"]).subset(["state"])
     assert clean.subset(["centre"]).trajectories[0].kinds == ("centre",)
+
+
+def test_from_arrays_and_csv_errors(tmp_path):
+    from jaxcelt.data import from_arrays, load_csv
+
+    t = np.linspace(0.0, 1.0, 11)
+    w = np.column_stack([np.sin(t), np.cos(t), 0.1 + t])
+    tr = from_arrays(t, omega=w, omega_pi=17.0, q_pi=0.04)
+    # default weights: 1 % of each channel's RMS
+    np.testing.assert_allclose(tr.sigma["omega"], 0.01 * np.sqrt(np.mean(w**2, axis=0)), rtol=1e-12)
+    assert tr.y0 is None
+    with pytest.raises(ValueError, match="unknown observation kind"):
+        from_arrays(t, gyro=w, omega_pi=17.0, q_pi=0.04)
+    with pytest.raises(ValueError, match="non-finite"):
+        from_arrays(t, omega=np.full_like(w, np.nan), omega_pi=17.0, q_pi=0.04)
+    bad = tmp_path / "bad.csv"
+    bad.write_text("t,omega1,omega2\n0,1,2\n0.1,1,2\n")
+    with pytest.raises(ValueError, match="needs all of the columns"):
+        load_csv(bad, omega_pi=17.0, q_pi=0.04)
+    nofreq = tmp_path / "nofreq.csv"
+    nofreq.write_text("t,omega1,omega2,omega3\n0,1,2,3\n0.1,1,2,3\n")
+    with pytest.raises(ValueError, match="omega_pi"):
+        load_csv(nofreq)
+    assert load_csv(nofreq, omega_pi=17.0, q_pi=0.04).obs["omega"].shape == (2, 3)

@@ -1,6 +1,7 @@
-"""``jaxcelt fit data.npz ...``: identify contact parameters from a measured-data file.
+"""``jaxcelt fit data.npz ...`` or ``jaxcelt fit rec1.csv rec2.csv --guess mu=0.2``: identify
+contact parameters from measured records.
 
-A thin layer over `jaxcelt.fit` and `jaxcelt.data.load_data`: parses options, shows a progress
+A thin layer over `jaxcelt.fit` and `jaxcelt.data.load_data` / `load_csv`: parses options, shows a progress
 bar with the loss, prints the fitted values with 95% intervals, writes a JSON result and figures.
 """
 
@@ -20,7 +21,21 @@ def register(sub) -> None:
         description="Fit parameters of the model to measured trajectories (file format: jaxcelt.data).",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
-    p.add_argument("data", type=Path, help="data file written by jaxcelt.data.save_data (.npz or .nc)")
+    p.add_argument(
+        "data",
+        type=Path,
+        nargs="+",
+        help="data file written by jaxcelt.data.save_data (.npz or .nc), or one CSV per record "
+        "(columns t, omega1..3, ...: jaxcelt.data.load_csv, docs/identification.md)",
+    )
+    p.add_argument(
+        "--guess",
+        default="",
+        metavar="NAME=VALUE,...",
+        help="initial guess, e.g. mu=0.2,k_r=0.4 (same as --set; applied after it)",
+    )
+    p.add_argument("--omega-pi", type=positive_float, default=None, help="base frequency [rad/s] for CSV records without one")
+    p.add_argument("--q-pi", type=positive_float, default=None, help="base amplitude [m] for CSV records without one")
     p.add_argument("--free", nargs="+", default=["mu", "k_r", "b_Ts", "m_Ts"], help="parameters to fit")
     p.add_argument(
         "--set",
@@ -51,19 +66,31 @@ def run(args) -> int:
     from tqdm import tqdm
 
     import jaxcelt as jc
-    from jaxcelt.data import load_data
+    from jaxcelt.data import MeasuredData, load_csv, load_data
     from jaxcelt.fit import fit
 
     # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2)
     params0 = jc.CeltParams.paper(**overrides(args.set))
     try:
-        data = load_data(args.data)
+        if all(p.suffix.lower() == ".csv" for p in args.data):
+            data = MeasuredData(tuple(load_csv(p, omega_pi=args.omega_pi, q_pi=args.q_pi) for p in args.data))
+        elif len(args.data) == 1:
+            data = load_data(args.data[0])
+        else:
+            raise UsageError("argument data: several files must all be CSV records (one .npz/.nc holds several records)")
     except (OSError, KeyError) as e:
-        raise UsageError(f"argument data: cannot read {str(args.data)!r}: {e}") from e
+        raise UsageError(f"argument data: cannot read {', '.join(map(str, args.data))!r}: {e}") from e
+    except UsageError:
+        raise
     except ValueError as e:
-        raise UsageError(f"argument data: {str(args.data)!r}: {e}") from e
+        raise UsageError(f"argument data: {', '.join(map(str, args.data))!r}: {e}") from e
     if args.kinds:
         data = data.subset(args.kinds)
+    try:
+        guess = [override(g) for g in args.guess.split(",") if g.strip()]
+    except argparse.ArgumentTypeError as e:
+        raise UsageError(f"argument --guess: {e}") from None
+    params0 = jc.CeltParams.paper(**overrides(list(args.set) + guess))
     bar = tqdm(total=args.max_iter, disable=args.quiet, desc=f"fit ({args.optimiser})", unit="it")
 
     def progress(it, loss, values):
@@ -90,7 +117,7 @@ def run(args) -> int:
     from jaxcelt.versions import versions
 
     (args.out / "fit.json").write_text(
-        json.dumps(res.to_dict() | {"data": str(args.data), "versions": versions()}, indent=1)
+        json.dumps(res.to_dict() | {"data": [str(p) for p in args.data], "versions": versions()}, indent=1)
     )
     print(f"wrote {args.out / 'fit.json'}")
     if not args.no_plot:
