@@ -361,10 +361,17 @@ def test_map_figure(pmap, tmp_path):
 def test_map_cli_rejects_bad_axis(capsys):
     from jaxcelt.cli import main
 
-    assert main(["map", "--x", "omega_pi:10:20:3", "--out", "unused"]) == 2
-    assert "jaxcelt map: error: --x expects NAME=START:STOP:COUNT" in capsys.readouterr().out
-    assert main(["map", "--y", "q_pi=-0.1:0.1:3", "--x", "omega_pi=15", "--out", "unused"]) == 2
-    assert "'q_pi'" in capsys.readouterr().out
+    # one stderr line naming the flag or parameter, exit 2, before any work (jaxcelt.cli)
+    for argv, named in (
+        (["map", "--x", "omega_pi:10:20:3", "--out", "unused"], "argument --x: expected NAME=START:STOP:COUNT"),
+        (["map", "--y", "q_pi=-0.1:0.1:3", "--x", "omega_pi=15", "--out", "unused"], "'q_pi'"),
+        (["map", "--x", "nonsense=1:2:3", "--out", "unused"], "'nonsense'"),
+    ):
+        with pytest.raises(SystemExit) as e:
+            main(argv)
+        assert e.value.code == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("jaxcelt map: error: ") and named in err[0], err
 
 
 @pytest.mark.slow
