@@ -307,18 +307,7 @@ class SweepWriter:
         return ds
 
 
-_CHUNK_SCALARS = (
-    "status",
-    "valid",
-    "first_invalid_t",
-    "first_invalid_kind",
-    "min_N",
-    "max_tilt",
-    "drift",
-    "max_excursion",
-    "num_steps",
-    "lyapunov",
-)
+_CHUNK_SCALARS = tuple(f for f in LANE_FIELDS if f not in _LANE_DIMS)
 """per-lane scalars every chunk file holds (besides samples, t_samples, r_O, y_final)"""
 
 

@@ -224,16 +224,36 @@ def _set_host_devices(spec: str) -> int:
     return n
 
 
+def run_settings(args, wall: float) -> dict:
+    """The settings and wall time of a sweep command (``bifurcation``, ``map``) for its summary.json."""
+    import jax
+
+    from jaxcelt.sweep import DEFAULT_WIDTH
+
+    return {
+        "transient_periods": args.transient,
+        "sample_periods": args.sample,
+        "lyapunov_periods": args.lyapunov,
+        "solver": args.solver,
+        "rtol": args.rtol,
+        "atol": args.atol,
+        "stop_on_invalid": bool(args.stop_on_invalid),
+        "devices": [str(d) for d in jax.local_devices()],
+        "chunk_size": args.chunk_size,
+        "width_per_device": args.width or DEFAULT_WIDTH,
+        "wall_seconds_including_compile": round(wall, 2),
+    }
+
+
 def run(args) -> int:
     _set_host_devices(args.host_devices)
-    import jax
     import numpy as np
 
     import jaxcelt as jc
     from jaxcelt.benchmarking import make_solver
     from jaxcelt.commands._warnings import one_line_warnings
     from jaxcelt.dataset import open_sweep
-    from jaxcelt.sweep import DEFAULT_WIDTH, sweep
+    from jaxcelt.sweep import sweep
     from jaxcelt.versions import versions_string
 
     # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2), before any work
@@ -282,17 +302,7 @@ def run(args) -> int:
         "command": "jaxcelt bifurcation",
         "param": args.param,
         "n_values": int(values.size),
-        "transient_periods": args.transient,
-        "sample_periods": args.sample,
-        "lyapunov_periods": args.lyapunov,
-        "solver": args.solver,
-        "rtol": args.rtol,
-        "atol": args.atol,
-        "stop_on_invalid": bool(args.stop_on_invalid),
-        "devices": [str(d) for d in jax.local_devices()],
-        "chunk_size": args.chunk_size,
-        "width_per_device": args.width or DEFAULT_WIDTH,
-        "wall_seconds_including_compile": round(wall, 2),
+        **run_settings(args, wall),
         "lanes_failed": int(np.sum(np.isin(ds["status"].values, (1, 3)))),  # status 2 = stopped invalid
         "lanes_invalid": int(np.sum(ds["valid"].values == 0)),
         "regimes": _ranges(ds),

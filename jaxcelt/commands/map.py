@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 
 from .args import UsageError, floats, nonnegative_int, override, overrides, positive_float, positive_int, value_range
-from .bifurcation import SWEEP_SOLVERS, _set_host_devices
+from .bifurcation import SWEEP_SOLVERS, _set_host_devices, run_settings
 
 
 def register(sub) -> None:
@@ -100,13 +100,11 @@ def summarize(ds) -> dict:
 
 def run(args) -> int:
     _set_host_devices(args.host_devices)
-    import jax
     import numpy as np
 
     import jaxcelt as jc
     from jaxcelt.benchmarking import make_solver
     from jaxcelt.commands._warnings import one_line_warnings
-    from jaxcelt.sweep import DEFAULT_WIDTH
     from jaxcelt.versions import versions_string
 
     # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2), before any work
@@ -136,17 +134,7 @@ def run(args) -> int:
         "x": {"name": x[0], "from": float(x[1][0]), "to": float(x[1][-1]), "n": int(x[1].size)},
         "y": {"name": y[0], "from": float(y[1][0]), "to": float(y[1][-1]), "n": int(y[1].size)},
         "set": args.set,
-        "transient_periods": args.transient,
-        "sample_periods": args.sample,
-        "lyapunov_periods": args.lyapunov,
-        "solver": args.solver,
-        "rtol": args.rtol,
-        "atol": args.atol,
-        "stop_on_invalid": bool(args.stop_on_invalid),
-        "devices": [str(d) for d in jax.local_devices()],
-        "chunk_size": args.chunk_size,
-        "width_per_device": args.width or DEFAULT_WIDTH,
-        "wall_seconds_including_compile": round(wall, 2),
+        **run_settings(args, wall),
         "load_average_at_start": None if load is None else [round(v, 2) for v in load],
         **summarize(ds),
     }
