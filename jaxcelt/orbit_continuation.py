@@ -26,11 +26,25 @@ from typing import Any, NamedTuple
 import jax
 import jax.numpy as jnp
 import numpy as np
+import optimistix as optx
 
 from ._types import Array
-from .periodic import PeriodicOrbit, find_periodic_orbit
+from .periodic import (
+    PeriodicOrbit,
+    find_periodic_orbit,
+    sort_multipliers,
+    stroboscopic_map,
+    variational_map,
+)
 
-__all__ = ["Bifurcation", "OrbitBranch", "continue_periodic_orbit", "BIFURCATION_KINDS"]
+__all__ = [
+    "ArclengthBranch",
+    "Bifurcation",
+    "OrbitBranch",
+    "continue_periodic_orbit",
+    "continue_pseudo_arclength",
+    "BIFURCATION_KINDS",
+]
 
 BIFURCATION_KINDS = ("period-doubling", "fold", "Neimark-Sacker")
 _IMAG_TOL = 1e-8
@@ -161,4 +175,172 @@ def continue_periodic_orbit(
         stable=np.asarray(stable),
         bifurcations=bifs,
         stopped_at=stopped,
+    )
+
+
+class ArclengthBranch(NamedTuple):
+    values: np.ndarray
+    """parameter values of the converged points (m,), not monotonic past a fold"""
+    y: np.ndarray
+    """orbit states (m, n)"""
+    tangents: np.ndarray
+    """unit tangents (m, n + 1) in (y, lam), oriented along the branch"""
+    multipliers: np.ndarray
+    """Floquet multipliers (m, n), by decreasing modulus"""
+    stable: np.ndarray
+    """(m,) bool"""
+    steps: np.ndarray
+    """arclength step that reached each point (m,) (0 for the first)"""
+    bifurcations: list[Bifurcation]
+    """crossings between consecutive points, in branch order; ``value`` interpolated linearly
+    in the test function between the bracketing points (folds: in the lam-component of the
+    tangent), so it is accurate to the local step size squared, not bisected"""
+    stopped: str
+    """why the branch ended: "end value reached", "max points" or "step below ds_min"."""
+
+
+def continue_pseudo_arclength(
+    vector_field: Callable[[Any, Array, Any], Array],
+    y_guess: Array,
+    args_of: Callable[[Array], Any],
+    period_of: Callable[[Any], Array],
+    lam0: float,
+    lam_end: float,
+    *,
+    ds: float = 0.02,
+    ds_min: float = 1e-5,
+    ds_max: float = 0.2,
+    max_points: int = 400,
+    k: int = 1,
+    t0: float = 0.0,
+    rtol: float = 1e-10,
+    atol: float = 1e-11,
+    max_steps: int = 100_000,
+    newton_tol: float = 1e-9,
+    newton_max_steps: int = 8,
+) -> ArclengthBranch:
+    """Pseudo-arclength continuation of the period-k orbit through ``y_guess`` at ``lam0``.
+
+    Unknowns u = (y, lam); each point solves (optimistix Newton) the augmented system
+    P^k(y; lam) - y = 0, t . (u - u_prev) - ds = 0 from the tangent predictor
+    u_prev + ds t, where t is the unit null vector of [dP/dy - I, dP/dlam] (oriented like the
+    previous tangent). Because lam is an unknown, the branch passes folds in lam. The step is
+    halved when Newton fails and grown x1.5 (up to ``ds_max``) when it converges in at most 3
+    iterations. Multipliers come from the variational equations (`variational_map`).
+
+    Args:
+        vector_field, args_of, period_of: as in `continue_periodic_orbit`.
+        lam0, lam_end: start value and the value at which the branch stops (once passed).
+        ds, ds_min, ds_max: initial, smallest and largest arclength step in (y, lam).
+        max_points: points at most.
+
+    Returns:
+        `ArclengthBranch` (host arrays).
+    """
+    ode = dict(k=k, t0=t0, rtol=rtol, atol=atol, max_steps=max_steps)
+    direction = np.sign(lam_end - lam0)
+    if direction == 0:
+        raise ValueError("lam_end must differ from lam0")
+
+    def P_minus(u):
+        y, lam = u[:-1], u[-1]
+        args = args_of(lam)
+        y1, ok, _ = stroboscopic_map(vector_field, y, args, period=period_of(args), **ode)
+        return y1 - y, ok
+
+    @jax.jit
+    def tangent(u, t_prev):
+        J = jax.jacfwd(lambda v: P_minus(v)[0])(u)
+        _, _, vt = jnp.linalg.svd(J)
+        t = vt[-1]
+        return t * jnp.sign(jnp.dot(t, t_prev) + 1e-300)
+
+    @jax.jit
+    def corrector(u_prev, t, h):
+        pred = u_prev + h * t
+
+        def fn(u, _):
+            return jnp.concatenate([P_minus(u)[0], jnp.dot(t, u - u_prev)[None] - h])
+
+        finder = optx.Newton(rtol=newton_tol, atol=newton_tol)
+        sol = optx.root_find(fn, finder, pred, max_steps=newton_max_steps, throw=False)
+        u = sol.value
+        res, ok = P_minus(u)
+        good = (sol.result == optx.RESULTS.successful) & ok & (jnp.max(jnp.abs(res)) < 10 * newton_tol)
+        return u, good, sol.stats["num_steps"]
+
+    @jax.jit
+    def floquet(u):
+        args = args_of(u[-1])
+        _, Phi, _, _ = variational_map(vector_field, u[:-1], args, period=period_of(args), **ode)
+        return sort_multipliers(jnp.linalg.eigvals(Phi))
+
+    @jax.jit
+    def first(lam, y0):
+        args = args_of(lam)
+        return find_periodic_orbit(vector_field, y0, args, period=period_of(args), newton_tol=newton_tol, **ode)
+
+    orb = first(jnp.asarray(lam0, float), jnp.asarray(y_guess, float))
+    if int(orb.status) != 0:
+        raise ValueError(f"y_guess: no period-{k} orbit found near it at lam0={lam0}")
+    n = orb.y.shape[0]
+    u = jnp.concatenate([orb.y, jnp.asarray([lam0], float)])
+    t = tangent(u, jnp.zeros(n + 1).at[-1].set(direction))
+    us, ts, mus, hs = [np.asarray(u)], [np.asarray(t)], [np.asarray(floquet(u))], [0.0]
+    h = ds
+    stopped = "max points"
+    while len(us) < max_points:
+        u_new, good, nsteps = corrector(u, t, h)
+        if not bool(good):
+            h *= 0.5
+            if h < ds_min:
+                stopped = "step below ds_min"
+                break
+            continue
+        t = tangent(u_new, t)
+        u = u_new
+        us.append(np.asarray(u))
+        ts.append(np.asarray(t))
+        mus.append(np.asarray(floquet(u)))
+        hs.append(h)
+        if int(nsteps) <= 3:
+            h = min(1.5 * h, ds_max)
+        if (float(u[-1]) - lam_end) * direction >= 0:
+            stopped = "end value reached"
+            break
+
+    U, TT, MU = np.asarray(us), np.asarray(ts), np.asarray(mus)
+    bifs: list[Bifurcation] = []
+    for i in range(1, len(U)):
+        ta, tb = _test_functions(MU[i - 1]), _test_functions(MU[i])
+        checks = {
+            "fold": (TT[i - 1, -1], TT[i, -1]),
+            "period-doubling": (ta["period-doubling"], tb["period-doubling"]),
+        }
+        for kind, (a, b) in checks.items():
+            if np.sign(a) != np.sign(b):
+                w = a / (a - b)
+                val = (1 - w) * U[i - 1, -1] + w * U[i, -1]
+                mu = (1 - w) * MU[i - 1] + w * MU[i]
+                y = (1 - w) * U[i - 1, :-1] + w * U[i, :-1]
+                bifs.append(Bifurcation(kind, float(val), (U[i - 1, -1], U[i, -1]), mu, y))
+        if ta["Neimark-Sacker"] != tb["Neimark-Sacker"]:
+            bifs.append(
+                Bifurcation(
+                    "Neimark-Sacker",
+                    float(0.5 * (U[i - 1, -1] + U[i, -1])),
+                    (U[i - 1, -1], U[i, -1]),
+                    MU[i],
+                    U[i, :-1],
+                )
+            )
+    return ArclengthBranch(
+        values=U[:, -1],
+        y=U[:, :-1],
+        tangents=TT,
+        multipliers=MU,
+        stable=np.all(np.abs(MU) < 1.0, axis=1),
+        steps=np.asarray(hs),
+        bifurcations=bifs,
+        stopped=stopped,
     )
