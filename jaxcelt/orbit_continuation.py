@@ -43,6 +43,7 @@ __all__ = [
     "OrbitBranch",
     "continue_periodic_orbit",
     "continue_pseudo_arclength",
+    "switch_at_period_doubling",
     "BIFURCATION_KINDS",
 ]
 
@@ -192,11 +193,29 @@ class ArclengthBranch(NamedTuple):
     steps: np.ndarray
     """arclength step that reached each point (m,) (0 for the first)"""
     bifurcations: list[Bifurcation]
-    """crossings between consecutive points, in branch order; ``value`` interpolated linearly
-    in the test function between the bracketing points (folds: in the lam-component of the
-    tangent), so it is accurate to the local step size squared, not bisected"""
+    """crossings between consecutive points, in branch order. ``value``: period doublings
+    bisected in lam on Re prod(1 + mu); folds and NS interpolated linearly between the
+    bracketing points (folds in the lam-component of the tangent), accurate to about the local
+    step squared"""
     stopped: str
     """why the branch ended: "end value reached", "max points" or "step below ds_min"."""
+
+
+def _bisect_pd(solve, ua, ub, tf_a, bisections):
+    lo, hi, y_lo, y_hi = ua[-1], ub[-1], ua[:-1], ub[:-1]
+    for _ in range(bisections):
+        mid = 0.5 * (lo + hi)
+        orb = solve(jnp.asarray(mid), jnp.asarray(0.5 * (y_lo + y_hi)))
+        if int(orb.status) != 0:
+            break
+        tf = _test_functions(np.asarray(orb.multipliers))["period-doubling"]
+        if np.sign(tf) == np.sign(tf_a):
+            lo, y_lo = mid, np.asarray(orb.y)
+        else:
+            hi, y_hi = mid, np.asarray(orb.y)
+    val = 0.5 * (lo + hi)
+    orb = solve(jnp.asarray(val), jnp.asarray(0.5 * (y_lo + y_hi)))
+    return val, np.asarray(orb.multipliers), np.asarray(orb.y)
 
 
 def continue_pseudo_arclength(
@@ -218,6 +237,7 @@ def continue_pseudo_arclength(
     max_steps: int = 100_000,
     newton_tol: float = 1e-9,
     newton_max_steps: int = 8,
+    bisections: int = 30,
 ) -> ArclengthBranch:
     """Pseudo-arclength continuation of the period-k orbit through ``y_guess`` at ``lam0``.
 
@@ -233,6 +253,8 @@ def continue_pseudo_arclength(
         lam0, lam_end: start value and the value at which the branch stops (once passed).
         ds, ds_min, ds_max: initial, smallest and largest arclength step in (y, lam).
         max_points: points at most.
+        bisections: halvings of the lam-bracket of each period doubling (a Newton solve in
+            lam at fixed lam each, from the interpolated state; 0: linear interpolation only).
 
     Returns:
         `ArclengthBranch` (host arrays).
@@ -323,6 +345,8 @@ def continue_pseudo_arclength(
                 val = (1 - w) * U[i - 1, -1] + w * U[i, -1]
                 mu = (1 - w) * MU[i - 1] + w * MU[i]
                 y = (1 - w) * U[i - 1, :-1] + w * U[i, :-1]
+                if kind == "period-doubling" and bisections:
+                    val, mu, y = _bisect_pd(first, U[i - 1], U[i], a, bisections)
                 bifs.append(Bifurcation(kind, float(val), (U[i - 1, -1], U[i, -1]), mu, y))
         if ta["Neimark-Sacker"] != tb["Neimark-Sacker"]:
             bifs.append(
@@ -344,3 +368,42 @@ def continue_pseudo_arclength(
         bifurcations=bifs,
         stopped=stopped,
     )
+
+
+def switch_at_period_doubling(
+    vector_field: Callable[[Any, Array, Any], Array],
+    bifurcation: Bifurcation,
+    args_of: Callable[[Array], Any],
+    period_of: Callable[[Any], Array],
+    *,
+    k: int = 1,
+    lam: float,
+    eps: float = 1e-2,
+    **find_kw,
+) -> PeriodicOrbit:
+    """The period-2k orbit born at a period doubling of a period-k branch, found at ``lam``.
+
+    Starts from the PD point +- ``eps`` along the eigenvector of the multiplier nearest -1 of
+    the period-k monodromy there (`variational_map`), and solves the period-2k problem at
+    ``lam`` (on the side of the doubling where the new orbit exists) with `find_periodic_orbit`.
+    The sign giving a converged orbit that is not the period-k one (its two section points
+    differ by more than eps/10) is returned; ``status`` is nonzero if neither does.
+    """
+    if bifurcation.kind != "period-doubling":
+        raise ValueError(f"bifurcation: expected a period-doubling, got {bifurcation.kind!r}")
+    ode = {key: find_kw[key] for key in ("t0", "rtol", "atol", "max_steps") if key in find_kw}
+    args_pd = args_of(jnp.asarray(bifurcation.value))
+    y_pd = jnp.asarray(bifurcation.y)
+    _, Phi, _, _ = variational_map(vector_field, y_pd, args_pd, period=period_of(args_pd), k=k, **ode)
+    mu, vecs = np.linalg.eig(np.asarray(Phi))
+    v = np.real(vecs[:, np.argmin(np.abs(mu + 1))])
+    v = v / np.linalg.norm(v)
+    args = args_of(jnp.asarray(lam))
+    orb = None
+    for sign in (1.0, -1.0):
+        orb = find_periodic_orbit(vector_field, y_pd + sign * eps * v, args, period=period_of(args), k=2 * k, **find_kw)
+        if int(orb.status) == 0:
+            y1, _, _ = stroboscopic_map(vector_field, orb.y, args, period=period_of(args), k=k, **ode)
+            if float(jnp.max(jnp.abs(y1 - orb.y))) > eps / 10:
+                return orb
+    return orb
