@@ -26,11 +26,26 @@ from typing import Any, NamedTuple
 import jax
 import jax.numpy as jnp
 import numpy as np
+import optimistix as optx
 
 from ._types import Array
-from .periodic import PeriodicOrbit, find_periodic_orbit
+from .periodic import (
+    PeriodicOrbit,
+    find_periodic_orbit,
+    sort_multipliers,
+    stroboscopic_map,
+    variational_map,
+)
 
-__all__ = ["Bifurcation", "OrbitBranch", "continue_periodic_orbit", "BIFURCATION_KINDS"]
+__all__ = [
+    "ArclengthBranch",
+    "Bifurcation",
+    "OrbitBranch",
+    "continue_periodic_orbit",
+    "continue_pseudo_arclength",
+    "switch_at_period_doubling",
+    "BIFURCATION_KINDS",
+]
 
 BIFURCATION_KINDS = ("period-doubling", "fold", "Neimark-Sacker")
 _IMAG_TOL = 1e-8
@@ -162,3 +177,233 @@ def continue_periodic_orbit(
         bifurcations=bifs,
         stopped_at=stopped,
     )
+
+
+class ArclengthBranch(NamedTuple):
+    values: np.ndarray
+    """parameter values of the converged points (m,), not monotonic past a fold"""
+    y: np.ndarray
+    """orbit states (m, n)"""
+    tangents: np.ndarray
+    """unit tangents (m, n + 1) in (y, lam), oriented along the branch"""
+    multipliers: np.ndarray
+    """Floquet multipliers (m, n), by decreasing modulus"""
+    stable: np.ndarray
+    """(m,) bool"""
+    steps: np.ndarray
+    """arclength step that reached each point (m,) (0 for the first)"""
+    bifurcations: list[Bifurcation]
+    """crossings between consecutive points, in branch order. ``value``: period doublings
+    bisected in lam on Re prod(1 + mu); folds and NS interpolated linearly between the
+    bracketing points (folds in the lam-component of the tangent), accurate to about the local
+    step squared"""
+    stopped: str
+    """why the branch ended: "end value reached", "max points" or "step below ds_min"."""
+
+
+def _bisect_pd(solve, ua, ub, tf_a, bisections):
+    lo, hi, y_lo, y_hi = ua[-1], ub[-1], ua[:-1], ub[:-1]
+    for _ in range(bisections):
+        mid = 0.5 * (lo + hi)
+        orb = solve(jnp.asarray(mid), jnp.asarray(0.5 * (y_lo + y_hi)))
+        if int(orb.status) != 0:
+            break
+        tf = _test_functions(np.asarray(orb.multipliers))["period-doubling"]
+        if np.sign(tf) == np.sign(tf_a):
+            lo, y_lo = mid, np.asarray(orb.y)
+        else:
+            hi, y_hi = mid, np.asarray(orb.y)
+    val = 0.5 * (lo + hi)
+    orb = solve(jnp.asarray(val), jnp.asarray(0.5 * (y_lo + y_hi)))
+    return val, np.asarray(orb.multipliers), np.asarray(orb.y)
+
+
+def continue_pseudo_arclength(
+    vector_field: Callable[[Any, Array, Any], Array],
+    y_guess: Array,
+    args_of: Callable[[Array], Any],
+    period_of: Callable[[Any], Array],
+    lam0: float,
+    lam_end: float,
+    *,
+    ds: float = 0.02,
+    ds_min: float = 1e-5,
+    ds_max: float = 0.2,
+    max_points: int = 400,
+    k: int = 1,
+    t0: float = 0.0,
+    rtol: float = 1e-10,
+    atol: float = 1e-11,
+    max_steps: int = 100_000,
+    newton_tol: float = 1e-9,
+    newton_max_steps: int = 8,
+    bisections: int = 30,
+) -> ArclengthBranch:
+    """Pseudo-arclength continuation of the period-k orbit through ``y_guess`` at ``lam0``.
+
+    Unknowns u = (y, lam); each point solves (optimistix Newton) the augmented system
+    P^k(y; lam) - y = 0, t . (u - u_prev) - ds = 0 from the tangent predictor
+    u_prev + ds t, where t is the unit null vector of [dP/dy - I, dP/dlam] (oriented like the
+    previous tangent). Because lam is an unknown, the branch passes folds in lam. The step is
+    halved when Newton fails and grown x1.5 (up to ``ds_max``) when it converges in at most 3
+    iterations. Multipliers come from the variational equations (`variational_map`).
+
+    Args:
+        vector_field, args_of, period_of: as in `continue_periodic_orbit`.
+        lam0, lam_end: start value and the value at which the branch stops (once passed).
+        ds, ds_min, ds_max: initial, smallest and largest arclength step in (y, lam).
+        max_points: points at most.
+        bisections: halvings of the lam-bracket of each period doubling (a Newton solve in
+            lam at fixed lam each, from the interpolated state; 0: linear interpolation only).
+
+    Returns:
+        `ArclengthBranch` (host arrays).
+    """
+    ode = dict(k=k, t0=t0, rtol=rtol, atol=atol, max_steps=max_steps)
+    direction = np.sign(lam_end - lam0)
+    if direction == 0:
+        raise ValueError("lam_end must differ from lam0")
+
+    def P_minus(u):
+        y, lam = u[:-1], u[-1]
+        args = args_of(lam)
+        y1, ok, _ = stroboscopic_map(vector_field, y, args, period=period_of(args), **ode)
+        return y1 - y, ok
+
+    @jax.jit
+    def tangent(u, t_prev):
+        J = jax.jacfwd(lambda v: P_minus(v)[0])(u)
+        _, _, vt = jnp.linalg.svd(J)
+        t = vt[-1]
+        return t * jnp.sign(jnp.dot(t, t_prev) + 1e-300)
+
+    @jax.jit
+    def corrector(u_prev, t, h):
+        pred = u_prev + h * t
+
+        def fn(u, _):
+            return jnp.concatenate([P_minus(u)[0], jnp.dot(t, u - u_prev)[None] - h])
+
+        finder = optx.Newton(rtol=newton_tol, atol=newton_tol)
+        sol = optx.root_find(fn, finder, pred, max_steps=newton_max_steps, throw=False)
+        u = sol.value
+        res, ok = P_minus(u)
+        good = (sol.result == optx.RESULTS.successful) & ok & (jnp.max(jnp.abs(res)) < 10 * newton_tol)
+        return u, good, sol.stats["num_steps"]
+
+    @jax.jit
+    def floquet(u):
+        args = args_of(u[-1])
+        _, Phi, _, _ = variational_map(vector_field, u[:-1], args, period=period_of(args), **ode)
+        return sort_multipliers(jnp.linalg.eigvals(Phi))
+
+    @jax.jit
+    def first(lam, y0):
+        args = args_of(lam)
+        return find_periodic_orbit(vector_field, y0, args, period=period_of(args), newton_tol=newton_tol, **ode)
+
+    orb = first(jnp.asarray(lam0, float), jnp.asarray(y_guess, float))
+    if int(orb.status) != 0:
+        raise ValueError(f"y_guess: no period-{k} orbit found near it at lam0={lam0}")
+    n = orb.y.shape[0]
+    u = jnp.concatenate([orb.y, jnp.asarray([lam0], float)])
+    t = tangent(u, jnp.zeros(n + 1).at[-1].set(direction))
+    us, ts, mus, hs = [np.asarray(u)], [np.asarray(t)], [np.asarray(floquet(u))], [0.0]
+    h = ds
+    stopped = "max points"
+    while len(us) < max_points:
+        u_new, good, nsteps = corrector(u, t, h)
+        if not bool(good):
+            h *= 0.5
+            if h < ds_min:
+                stopped = "step below ds_min"
+                break
+            continue
+        t = tangent(u_new, t)
+        u = u_new
+        us.append(np.asarray(u))
+        ts.append(np.asarray(t))
+        mus.append(np.asarray(floquet(u)))
+        hs.append(h)
+        if int(nsteps) <= 3:
+            h = min(1.5 * h, ds_max)
+        if (float(u[-1]) - lam_end) * direction >= 0:
+            stopped = "end value reached"
+            break
+
+    U, TT, MU = np.asarray(us), np.asarray(ts), np.asarray(mus)
+    bifs: list[Bifurcation] = []
+    for i in range(1, len(U)):
+        ta, tb = _test_functions(MU[i - 1]), _test_functions(MU[i])
+        checks = {
+            "fold": (TT[i - 1, -1], TT[i, -1]),
+            "period-doubling": (ta["period-doubling"], tb["period-doubling"]),
+        }
+        for kind, (a, b) in checks.items():
+            if np.sign(a) != np.sign(b):
+                w = a / (a - b)
+                val = (1 - w) * U[i - 1, -1] + w * U[i, -1]
+                mu = (1 - w) * MU[i - 1] + w * MU[i]
+                y = (1 - w) * U[i - 1, :-1] + w * U[i, :-1]
+                if kind == "period-doubling" and bisections:
+                    val, mu, y = _bisect_pd(first, U[i - 1], U[i], a, bisections)
+                bifs.append(Bifurcation(kind, float(val), (U[i - 1, -1], U[i, -1]), mu, y))
+        if ta["Neimark-Sacker"] != tb["Neimark-Sacker"]:
+            bifs.append(
+                Bifurcation(
+                    "Neimark-Sacker",
+                    float(0.5 * (U[i - 1, -1] + U[i, -1])),
+                    (U[i - 1, -1], U[i, -1]),
+                    MU[i],
+                    U[i, :-1],
+                )
+            )
+    return ArclengthBranch(
+        values=U[:, -1],
+        y=U[:, :-1],
+        tangents=TT,
+        multipliers=MU,
+        stable=np.all(np.abs(MU) < 1.0, axis=1),
+        steps=np.asarray(hs),
+        bifurcations=bifs,
+        stopped=stopped,
+    )
+
+
+def switch_at_period_doubling(
+    vector_field: Callable[[Any, Array, Any], Array],
+    bifurcation: Bifurcation,
+    args_of: Callable[[Array], Any],
+    period_of: Callable[[Any], Array],
+    *,
+    k: int = 1,
+    lam: float,
+    eps: float = 1e-2,
+    **find_kw,
+) -> PeriodicOrbit:
+    """The period-2k orbit born at a period doubling of a period-k branch, found at ``lam``.
+
+    Starts from the PD point +- ``eps`` along the eigenvector of the multiplier nearest -1 of
+    the period-k monodromy there (`variational_map`), and solves the period-2k problem at
+    ``lam`` (on the side of the doubling where the new orbit exists) with `find_periodic_orbit`.
+    The sign giving a converged orbit that is not the period-k one (its two section points
+    differ by more than eps/10) is returned; ``status`` is nonzero if neither does.
+    """
+    if bifurcation.kind != "period-doubling":
+        raise ValueError(f"bifurcation: expected a period-doubling, got {bifurcation.kind!r}")
+    ode = {key: find_kw[key] for key in ("t0", "rtol", "atol", "max_steps") if key in find_kw}
+    args_pd = args_of(jnp.asarray(bifurcation.value))
+    y_pd = jnp.asarray(bifurcation.y)
+    _, Phi, _, _ = variational_map(vector_field, y_pd, args_pd, period=period_of(args_pd), k=k, **ode)
+    mu, vecs = np.linalg.eig(np.asarray(Phi))
+    v = np.real(vecs[:, np.argmin(np.abs(mu + 1))])
+    v = v / np.linalg.norm(v)
+    args = args_of(jnp.asarray(lam))
+    orb = None
+    for sign in (1.0, -1.0):
+        orb = find_periodic_orbit(vector_field, y_pd + sign * eps * v, args, period=period_of(args), k=2 * k, **find_kw)
+        if int(orb.status) == 0:
+            y1, _, _ = stroboscopic_map(vector_field, orb.y, args, period=period_of(args), k=k, **ode)
+            if float(jnp.max(jnp.abs(y1 - orb.y))) > eps / 10:
+                return orb
+    return orb
