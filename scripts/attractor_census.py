@@ -1,0 +1,141 @@
+"""Attractor census of the wobblestone at omega_pi = 14, 15.6, 17, 19 rad/s (paper parameters).
+
+Every frequency: a psi0 x tilt grid of starts at rest (`jaxcelt.attractor_starts`), each run as
+one lane of `jaxcelt.sweep` (`jaxcelt.attractors`): transient, then stroboscopic samples,
+labelled periodic-k / quasi-periodic / chaotic / aperiodic / invalid / failed; periodic lanes
+grouped into distinct attractors. Resumable per frequency: a frequency whose result is in
+``<out>/census/omega_<w>.json`` is skipped. Writes ``<out>/census.json`` (all frequencies:
+attractor tables, fractions, wall time, first-chunk vs later-chunk time (compilation is in
+the first), jax version, machine, load average) and basin maps ``<out>/census/basins_<w>.png``.
+Timings are indicative (shared machine: load average recorded).
+
+    python scripts/attractor_census.py [--out docs/orbits] [--grid 40 25] [--transient 48]
+        [--sample 12] [--tilt 0.1] [--omega 14 15.6 17 19] [--refine] [--plot-only]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import time
+from pathlib import Path
+
+import jax
+
+jax.config.update("jax_num_cpu_devices", os.cpu_count() or 1)  # before the first JAX operation
+
+import numpy as np  # noqa: E402
+
+import jaxcelt as jc  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+OMEGAS = (14.0, 15.6, 17.0, 19.0)
+
+
+def _name(w: float) -> str:
+    return f"{w:g}".replace(".", "p")
+
+
+def run_one(w: float, args) -> dict:
+    p = jc.CeltParams.paper(omega_pi=w)
+    starts = jc.attractor_starts(p, psi0=(0.0, 2 * np.pi), tilt=(-args.tilt, args.tilt), n=tuple(args.grid))
+    chunk_times: list[float] = []
+    t_last = [time.perf_counter()]
+
+    def on_chunk(i, _):
+        t = time.perf_counter()
+        chunk_times.append(t - t_last[0])
+        t_last[0] = t
+
+    load0 = os.getloadavg()
+    t0 = time.perf_counter()
+    c = jc.attractors(
+        p,
+        starts,
+        transient_periods=args.transient,
+        sample_periods=args.sample,
+        lyapunov_periods=args.lyapunov,
+        chunk_size=args.chunk,
+        on_chunk=on_chunk,
+        refine=args.refine,
+    )
+    wall = time.perf_counter() - t0
+    d = c.to_dict()
+    d.update(
+        wall_s=round(wall, 1),
+        chunk_wall_s=[round(x, 1) for x in chunk_times],
+        chunk_lanes=args.chunk,
+        load_average_start=[round(x, 2) for x in load0],
+        load_average_end=[round(x, 2) for x in os.getloadavg()],
+        tilt_axis="n = (sin tilt, 0, cos tilt), at rest",
+    )
+    return d
+
+
+def plot(d: dict, path: Path) -> None:
+    from jaxcelt.plotting.attractors import plot_basins
+
+    fig = plot_basins(d)
+    fig.savefig(path, dpi=110)
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", default=str(ROOT / "docs" / "orbits"))
+    ap.add_argument("--omega", type=float, nargs="+", default=list(OMEGAS))
+    ap.add_argument("--grid", type=int, nargs=2, default=[40, 25], metavar=("N_PSI0", "N_TILT"))
+    ap.add_argument("--tilt", type=float, default=0.1, help="tilt range +-TILT [rad]")
+    ap.add_argument("--transient", type=int, default=48)
+    ap.add_argument("--sample", type=int, default=12)
+    ap.add_argument("--lyapunov", type=int, default=0)
+    ap.add_argument("--chunk", type=int, default=500)
+    ap.add_argument("--refine", action="store_true")
+    ap.add_argument("--plot-only", action="store_true")
+    args = ap.parse_args(argv)
+    out = Path(args.out)
+    (out / "census").mkdir(parents=True, exist_ok=True)
+    for w in args.omega:
+        f = out / "census" / f"omega_{_name(w)}.json"
+        if f.exists():
+            d = json.loads(f.read_text())
+            print(f"omega_pi = {w:g}: done ({f}), skipped", flush=True)
+        elif args.plot_only:
+            continue
+        else:
+            print(f"omega_pi = {w:g}: running", flush=True)
+            d = run_one(w, args)
+            f.write_text(json.dumps(d))
+            print(f"omega_pi = {w:g}: {d['wall_s']} s, " + ", ".join(
+                f"{a['name']} {a['fraction']:.3f}" for a in d["attractors"]), flush=True)  # fmt: skip
+        png = out / "census" / f"basins_{_name(w)}.png"
+        if not png.exists():
+            try:
+                plot(d, png)
+            except ImportError as e:
+                print(f"no basin plot: {e}", flush=True)
+    summary = dict(
+        omega_pi=[],
+        results={},
+        jax_version=jax.__version__,
+        jaxcelt_version=jc.__version__,
+        machine=dict(platform=platform.platform(), processor=platform.machine(), cpu_count=os.cpu_count()),
+        devices=[str(x) for x in jax.devices()],
+        script="scripts/attractor_census.py",
+    )
+    for w in args.omega:
+        f = out / "census" / f"omega_{_name(w)}.json"
+        if f.exists():
+            d = json.loads(f.read_text())
+            d.pop("lanes", None)
+            summary["omega_pi"].append(w)
+            summary["results"][f"{w:g}"] = d
+    (out / "census.json").write_text(json.dumps(summary, indent=1))
+
+
+if __name__ == "__main__":
+    main()
