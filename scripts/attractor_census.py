@@ -3,14 +3,14 @@
 Every frequency: a psi0 x tilt grid of starts at rest (`jaxcelt.attractor_starts`), each run as
 one lane of `jaxcelt.sweep` (`jaxcelt.attractors`): transient, then stroboscopic samples,
 labelled periodic-k / quasi-periodic / chaotic / aperiodic / invalid / failed; periodic lanes
-grouped into distinct attractors. Resumable per frequency: a frequency whose result is in
-``<out>/census/omega_<w>.json`` is skipped. Writes ``<out>/census.json`` (all frequencies:
+grouped into distinct attractors. Resumable per frequency: a frequency whose result (with the same grid, tilt and
+periods) is in ``<out>/census/omega_<w>.json`` is skipped. Writes ``<out>/census.json`` (all frequencies:
 attractor tables, fractions, wall time, first-chunk vs later-chunk time (compilation is in
 the first), jax version, machine, load average) and basin maps ``<out>/census/basins_<w>.png``.
 Timings are indicative (shared machine: load average recorded).
 
-    python scripts/attractor_census.py [--out docs/orbits] [--grid 40 25] [--transient 48]
-        [--sample 12] [--tilt 0.1] [--omega 14 15.6 17 19] [--refine] [--plot-only]
+    python scripts/attractor_census.py [--out docs/orbits] [--grid 40 25] [--transient 200]
+        [--sample 16] [--tilt 0.1] [--omega 14 15.6 17 19] [--refine] [--plot-only]
 """
 
 from __future__ import annotations
@@ -90,8 +90,8 @@ def main(argv=None) -> None:
     ap.add_argument("--omega", type=float, nargs="+", default=list(OMEGAS))
     ap.add_argument("--grid", type=int, nargs=2, default=[40, 25], metavar=("N_PSI0", "N_TILT"))
     ap.add_argument("--tilt", type=float, default=0.1, help="tilt range +-TILT [rad]")
-    ap.add_argument("--transient", type=int, default=48)
-    ap.add_argument("--sample", type=int, default=12)
+    ap.add_argument("--transient", type=int, default=200)
+    ap.add_argument("--sample", type=int, default=16)
     ap.add_argument("--lyapunov", type=int, default=0)
     ap.add_argument("--chunk", type=int, default=500)
     ap.add_argument("--refine", action="store_true")
@@ -101,14 +101,17 @@ def main(argv=None) -> None:
     (out / "census").mkdir(parents=True, exist_ok=True)
     for w in args.omega:
         f = out / "census" / f"omega_{_name(w)}.json"
-        if f.exists():
-            d = json.loads(f.read_text())
+        want = dict(grid=list(args.grid), tilt=args.tilt, transient=args.transient, sample=args.sample)
+        d = json.loads(f.read_text()) if f.exists() else None
+        if d is not None and d.get("request") == want:
             print(f"omega_pi = {w:g}: done ({f}), skipped", flush=True)
         elif args.plot_only:
             continue
         else:
             print(f"omega_pi = {w:g}: running", flush=True)
             d = run_one(w, args)
+            d["request"] = want
+            (out / "census" / f"basins_{_name(w)}.png").unlink(missing_ok=True)
             f.write_text(json.dumps(d))
             print(f"omega_pi = {w:g}: {d['wall_s']} s, " + ", ".join(
                 f"{a['name']} {a['fraction']:.3f}" for a in d["attractors"]), flush=True)  # fmt: skip
