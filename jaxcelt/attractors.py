@@ -38,7 +38,15 @@ from .regimes import REGIMES, classify
 from .state import initial_state
 from .sweep import sweep
 
-__all__ = ["AttractorStarts", "Attractor", "AttractorCensus", "attractor_starts", "attractors", "same_cycle"]
+__all__ = [
+    "AttractorStarts",
+    "Attractor",
+    "AttractorCensus",
+    "attractor_starts",
+    "attractors",
+    "refine_attractor",
+    "same_cycle",
+]
 
 _PSI = 12
 _LOCAL = slice(0, 9)  # v, omega, n (r_C = 9:12 cyclic, psi = 12 compared modulo 2 pi)
@@ -379,7 +387,7 @@ def attractors(
     if refine:
         for a in table:
             if a.kind == "periodic":
-                _refine(params, a, refine_options or {})
+                refine_attractor(params, a, **(refine_options or {}))
     settings = dict(
         transient_periods=int(transient_periods),
         sample_periods=int(sample_periods),
@@ -406,8 +414,17 @@ def attractors(
     )
 
 
-def _refine(params: CeltParams, a: Attractor, options: dict[str, Any]) -> None:
+def refine_attractor(params: CeltParams, a: Attractor, **options: Any) -> Attractor:
+    """Refine a periodic row with `jaxcelt.periodic_orbit` from its section state (in place).
+
+    Sets ``refine_status``, ``residual`` and, when Newton converged, ``multipliers`` (|mu|,
+    decreasing) and ``stable``; an exception is caught and reported in ``refine_status``.
+    ``options``: keyword arguments of `periodic_orbit`. Returns ``a``.
+    """
     from .celt_orbit import periodic_orbit
+
+    if a.kind != "periodic":
+        raise ValueError(f"refine_attractor: 'a' must be a periodic attractor, got kind {a.kind!r}")
 
     try:
         orb = periodic_orbit(params, a.state, k=a.k, t0=a.t_section, **options)
@@ -420,3 +437,4 @@ def _refine(params: CeltParams, a: Attractor, options: dict[str, Any]) -> None:
             a.stable = bool(np.all(mu < 1.0))
     except Exception as e:  # noqa: BLE001  (a failed refinement is reported, never fatal)
         a.refine_status = f"error: {type(e).__name__}: {e}"[:200]
+    return a

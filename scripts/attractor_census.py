@@ -10,7 +10,7 @@ the first), jax version, machine, load average) and basin maps ``<out>/census/ba
 Timings are indicative (shared machine: load average recorded).
 
     python scripts/attractor_census.py [--out docs/orbits] [--grid 40 25] [--transient 200]
-        [--sample 16] [--tilt 0.1] [--omega 14 15.6 17 19] [--refine] [--plot-only]
+        [--sample 16] [--tilt 0.1] [--omega 14 15.6 17 19] [--refine] [--plot-only] [--refine-stored]
 """
 
 from __future__ import annotations
@@ -74,6 +74,29 @@ def run_one(w: float, args) -> dict:
     return d
 
 
+def refine_stored(w: float, d: dict) -> None:
+    """Refine the stored periodic rows with `jaxcelt.periodic_orbit` (in place; timed)."""
+    from jaxcelt.attractors import Attractor, refine_attractor
+
+    p = jc.CeltParams.paper(omega_pi=w)
+    for row in d["attractors"]:
+        if row["kind"] != "periodic" or row["refine_status"] != "not run":
+            continue
+        a = Attractor(**{k: v for k, v in row.items() if k in Attractor.__dataclass_fields__})
+        a.state = np.asarray(a.state, float)
+        a.lyapunov = float("nan") if a.lyapunov is None else a.lyapunov
+        t = time.perf_counter()
+        refine_attractor(p, a)
+        row.update(
+            refine_status=a.refine_status,
+            residual=a.residual,
+            multipliers=a.multipliers,
+            stable=a.stable,
+            refine_wall_s=round(time.perf_counter() - t, 1),
+        )
+        print(f"omega_pi = {w:g}: period-{a.k} ({a.count} lanes): {a.refine_status}, |mu| {a.multipliers}", flush=True)
+
+
 def plot(d: dict, path: Path) -> None:
     from jaxcelt.plotting.attractors import plot_basins
 
@@ -96,6 +119,9 @@ def main(argv=None) -> None:
     ap.add_argument("--chunk", type=int, default=500)
     ap.add_argument("--refine", action="store_true")
     ap.add_argument("--plot-only", action="store_true")
+    ap.add_argument(
+        "--refine-stored", action="store_true", help="refine the stored periodic attractors (periodic_orbit)"
+    )
     args = ap.parse_args(argv)
     out = Path(args.out)
     (out / "census").mkdir(parents=True, exist_ok=True)
@@ -105,7 +131,7 @@ def main(argv=None) -> None:
         d = json.loads(f.read_text()) if f.exists() else None
         if d is not None and d.get("request") == want:
             print(f"omega_pi = {w:g}: done ({f}), skipped", flush=True)
-        elif args.plot_only:
+        elif args.plot_only or args.refine_stored:
             continue
         else:
             print(f"omega_pi = {w:g}: running", flush=True)
@@ -115,6 +141,9 @@ def main(argv=None) -> None:
             f.write_text(json.dumps(d))
             print(f"omega_pi = {w:g}: {d['wall_s']} s, " + ", ".join(
                 f"{a['name']} {a['fraction']:.3f}" for a in d["attractors"]), flush=True)  # fmt: skip
+        if args.refine_stored:
+            refine_stored(w, d)
+            f.write_text(json.dumps(d))
         png = out / "census" / f"basins_{_name(w)}.png"
         if not png.exists():
             try:

@@ -149,3 +149,17 @@ def test_plot_basins_grid():
     assert len(set(attractor_colours(rows))) == 3
     with pytest.raises(ValueError, match="census"):
         plot_basins(dict(d, lanes=None))
+
+
+def test_refine_failure_is_reported_not_raised():
+    from jaxcelt.attractors import Attractor, refine_attractor
+
+    p = jc.CeltParams.paper(omega_pi=15.6)
+    row = Attractor(kind="periodic", k=1, state=np.zeros(13), t_section=0.0, lane=0, count=1, fraction=1.0)
+    # a state off the contact manifold: periodic_orbit rejects it; the row is marked, no exception
+    refine_attractor(p, row)
+    assert row.refine_status.startswith("error: ValueError") and row.multipliers is None and row.stable is None
+    with pytest.raises(ValueError, match="'a'"):
+        refine_attractor(
+            p, Attractor(kind="chaotic", k=0, state=np.zeros(13), t_section=0.0, lane=0, count=1, fraction=1.0)
+        )
