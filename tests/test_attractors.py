@@ -132,7 +132,7 @@ def test_plot_basins_grid():
     from jaxcelt.plotting.attractors import attractor_colours, plot_basins
 
     rows = [
-        dict(kind="periodic", k=1, fraction=0.5, count=3),
+        dict(kind="periodic", k=1, fraction=0.5, count=3, state=[0.0] * 12 + [2.0 + 4 * np.pi]),
         dict(kind="periodic", k=2, fraction=1 / 3, count=2),
         dict(kind="invalid", k=0, fraction=1 / 6, count=1),
     ]
@@ -145,7 +145,8 @@ def test_plot_basins_grid():
     )
     fig = plot_basins(d)
     texts = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
-    assert texts == ["period-1: 0.500 (3)", "period-2: 0.333 (2)", "invalid: 0.167 (1)"]
+    # psi of the representative modulo 360 deg: 2 rad = 114.6 deg
+    assert texts == ["period-1 ($\\psi$ = 115°): 0.500 (3)", "period-2: 0.333 (2)", "invalid: 0.167 (1)"]
     assert len(set(attractor_colours(rows))) == 3
     with pytest.raises(ValueError, match="census"):
         plot_basins(dict(d, lanes=None))

@@ -72,6 +72,9 @@ def plot_basins(census: Any, *, title: str | None = None, ax: Any = None):
     handles = []
     for a, c in zip(rows, colours, strict=True):
         name = a.get("name") or (f"period-{a['k']}" if a["kind"] == "periodic" else a["kind"])
+        psi = (a.get("state") or [None] * 13)[12]
+        if a["kind"] == "periodic" and psi is not None:  # tells symmetric orbits apart
+            name += rf" ($\psi$ = {np.degrees(psi) % 360:.0f}°)"
         handles.append(Patch(color=c, label=f"{name}: {a['fraction']:.3f} ({a['count']})"))
     ax.legend(handles=handles, loc="center left", bbox_to_anchor=(1.01, 0.5), fontsize=8, title="attractor: fraction")
     s = d.get("settings", {})
