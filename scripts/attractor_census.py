@@ -23,12 +23,9 @@ import time
 from pathlib import Path
 
 import jax
+import numpy as np
 
-jax.config.update("jax_num_cpu_devices", os.cpu_count() or 1)  # before the first JAX operation
-
-import numpy as np  # noqa: E402
-
-import jaxcelt as jc  # noqa: E402
+import jaxcelt as jc
 
 ROOT = Path(__file__).resolve().parents[1]
 OMEGAS = (14.0, 15.6, 17.0, 19.0)
@@ -107,6 +104,28 @@ def plot(d: dict, path: Path) -> None:
     plt.close(fig)
 
 
+def markdown_table(summary: dict) -> str:
+    """The census table of docs/orbits/README.md from census.json (one row per frequency)."""
+    lines = [
+        "| ω_π [rad/s] | starts | periodic attractors: k, ψ on the section, fraction, max \\|μ\\| "
+        "| aperiodic | invalid | wall time [s] |",
+        "|---|---|---|---|---|---|",
+    ]
+    for w in summary["omega_pi"]:
+        r = summary["results"][f"{w:g}"]
+        per = []
+        for a in r["attractors"]:
+            if a["kind"] == "periodic":
+                mu = f"{a['multipliers'][0]:.4f}" if a.get("multipliers") else a["refine_status"]
+                per.append(f"period-{a['k']}, {np.degrees(a['state'][12]) % 360:.1f}°, {a['fraction']:.3f}, {mu}")
+        frac = {a["kind"]: a["fraction"] for a in r["attractors"] if a["kind"] != "periodic"}
+        lines.append(
+            f"| {w:g} | {r['n_lanes']} | {'; '.join(per) or 'none'} | {frac.get('aperiodic', 0.0):.3f} "
+            f"| {frac.get('invalid', 0.0):.3f} | {r['wall_s']:.0f} |"
+        )
+    return "\n".join(lines)
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=str(ROOT / "docs" / "orbits"))
@@ -119,11 +138,16 @@ def main(argv=None) -> None:
     ap.add_argument("--chunk", type=int, default=500)
     ap.add_argument("--refine", action="store_true")
     ap.add_argument("--plot-only", action="store_true")
+    ap.add_argument("--table", action="store_true", help="print the README table from <out>/census.json and exit")
     ap.add_argument(
         "--refine-stored", action="store_true", help="refine the stored periodic attractors (periodic_orbit)"
     )
     args = ap.parse_args(argv)
     out = Path(args.out)
+    jax.config.update("jax_num_cpu_devices", os.cpu_count() or 1)  # before the first JAX operation
+    if args.table:
+        print(markdown_table(json.loads((out / "census.json").read_text())))
+        return
     (out / "census").mkdir(parents=True, exist_ok=True)
     for w in args.omega:
         f = out / "census" / f"omega_{_name(w)}.json"
