@@ -104,6 +104,34 @@ def plot(d: dict, path: Path) -> None:
     plt.close(fig)
 
 
+def symmetry(d: dict) -> dict | None:
+    """Agreement of the basin map with its image under (psi0, tilt) -> (psi0 + 180 deg, -tilt).
+
+    ``kind``: fraction of grid cells whose kind equals that of the image cell; ``periodic_swap``:
+    fraction of cells where "in the first periodic basin" equals "image in the second" (two
+    periodic attractors only). Needs an even psi0 grid over a full turn and a tilt range
+    symmetric about 0; else None.
+    """
+    shape, lanes = d.get("grid_shape"), d.get("lanes")
+    if shape is None or shape[0] % 2 or lanes is None:
+        return None
+    a, b = shape
+    psi = np.asarray(lanes["psi0"]).reshape(a, b)
+    tilt = np.asarray(lanes["tilt"]).reshape(a, b)
+    if not (np.allclose(psi[a // 2 :, 0] - psi[: a // 2, 0], np.pi) and np.allclose(tilt[0], -tilt[0, ::-1])):
+        return None
+
+    def image(x):
+        return np.roll(x, a // 2, axis=0)[:, ::-1]
+
+    kind = np.asarray(lanes["kind"], dtype=object).reshape(a, b)
+    out = dict(kind=float(np.mean(kind == image(kind))))
+    if sum(r["kind"] == "periodic" for r in d["attractors"]) == 2:
+        lab = np.asarray(lanes["label"]).reshape(a, b)
+        out["periodic_swap"] = float(np.mean((lab == 0) == (image(lab) == 1)))
+    return out
+
+
 def markdown_table(summary: dict) -> str:
     """The census table of docs/orbits/README.md from census.json (one row per frequency)."""
     lines = [
@@ -187,6 +215,7 @@ def main(argv=None) -> None:
         f = out / "census" / f"omega_{_name(w)}.json"
         if f.exists():
             d = json.loads(f.read_text())
+            d["symmetry"] = symmetry(d)
             d.pop("lanes", None)
             summary["omega_pi"].append(w)
             summary["results"][f"{w:g}"] = d
