@@ -141,6 +141,18 @@ QUOTES = [
         "docs/bifurcation/README.md",
         lambda: f"| {_json('docs/bifurcation/step_parts.json')['us_per_lane']['diffrax tsit5 step + monitor']:.2f} |",
     ),
+    # attractor census (scripts/attractor_census.py)
+    (
+        "docs/orbits/README.md",
+        lambda: "at 14 rad/s {} s vs {} s".format(*_json("docs/orbits/census.json")["results"]["14"]["chunk_wall_s"]),
+    ),
+    (
+        "docs/orbits/README.md",
+        lambda: "load average {:.2f}–{:.2f}".format(
+            min(r["load_average_start"][0] for r in _json("docs/orbits/census.json")["results"].values()),
+            max(r["load_average_start"][0] for r in _json("docs/orbits/census.json")["results"].values()),
+        ),
+    ),
     # paper reproduction (scripts/paper_study.py, scripts/paper_figures.py)
     ("README.md", lambda: f"{len(_starts())} initial conditions"),
     ("docs/paper-reproduction.md", lambda: f"{len(_starts())} starts"),
@@ -159,6 +171,17 @@ def test_quoted_number_matches_its_result_file(doc, quote):
     text = " ".join(_text(doc).split())  # line breaks in prose are spaces
     expected = quote()
     assert expected in text, f"{doc} should quote {expected!r} (from its result file)"
+
+
+def test_attractor_census_table_from_census_json():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("attractor_census", ROOT / "scripts" / "attractor_census.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    text = _text("docs/orbits/README.md")
+    for line in mod.markdown_table(_json("docs/orbits/census.json")).splitlines():
+        assert line in text, f"docs/orbits/README.md should contain {line!r} (from census.json)"
 
 
 def test_heading_study_has_sixteen_headings_and_a_roll():
