@@ -153,6 +153,25 @@ QUOTES = [
             max(r["load_average_start"][0] for r in _json("docs/orbits/census.json")["results"].values()),
         ),
     ),
+    (
+        "docs/orbits/README.md",
+        lambda: (
+            "chaotic {:.3f} (median λ₁ {:.3f} s⁻¹), invalid {:.3f}, quasi-periodic {:.3f}, and none periodic".format(
+                *(
+                    lambda a: (
+                        (a["chaotic"]["fraction"], a["chaotic"]["lyapunov"], a["invalid"]["fraction"])
+                        + (a["quasi-periodic"]["fraction"],)
+                    )
+                )(
+                    {
+                        r["kind"]: r
+                        for r in _json("docs/orbits/census_long14/census.json")["results"]["14"]["attractors"]
+                        if "periodic" not in r["kind"] or r["kind"] == "quasi-periodic"
+                    }
+                )
+            )
+        ),
+    ),
     # paper reproduction (scripts/paper_study.py, scripts/paper_figures.py)
     ("README.md", lambda: f"{len(_starts())} initial conditions"),
     ("docs/paper-reproduction.md", lambda: f"{len(_starts())} starts"),
