@@ -51,6 +51,16 @@ def _lambda14() -> tuple[float, float]:
     return min(lam), max(lam)
 
 
+def _long14() -> str:
+    rows = {r["kind"]: r for r in _json("docs/orbits/census_long14/census.json")["results"]["14"]["attractors"]}
+    c, i, q = rows["chaotic"], rows["invalid"], rows["quasi-periodic"]
+    periodic = "none periodic" if "periodic" not in rows else "some periodic"
+    return (
+        f"chaotic {c['fraction']:.3f} (median λ₁ {c['lyapunov']:.3f} s⁻¹), invalid {i['fraction']:.3f}, "
+        f"quasi-periodic {q['fraction']:.3f}, and {periodic}"
+    )
+
+
 # (document, quoted text computed from the result file)
 QUOTES = [
     # main job and the full-size CLI run (summary.json written by `jaxcelt bifurcation`)
@@ -153,25 +163,7 @@ QUOTES = [
             max(r["load_average_start"][0] for r in _json("docs/orbits/census.json")["results"].values()),
         ),
     ),
-    (
-        "docs/orbits/README.md",
-        lambda: (
-            "chaotic {:.3f} (median λ₁ {:.3f} s⁻¹), invalid {:.3f}, quasi-periodic {:.3f}, and none periodic".format(
-                *(
-                    lambda a: (
-                        (a["chaotic"]["fraction"], a["chaotic"]["lyapunov"], a["invalid"]["fraction"])
-                        + (a["quasi-periodic"]["fraction"],)
-                    )
-                )(
-                    {
-                        r["kind"]: r
-                        for r in _json("docs/orbits/census_long14/census.json")["results"]["14"]["attractors"]
-                        if "periodic" not in r["kind"] or r["kind"] == "quasi-periodic"
-                    }
-                )
-            )
-        ),
-    ),
+    ("docs/orbits/README.md", lambda: _long14()),
     # paper reproduction (scripts/paper_study.py, scripts/paper_figures.py)
     ("README.md", lambda: f"{len(_starts())} initial conditions"),
     ("docs/paper-reproduction.md", lambda: f"{len(_starts())} starts"),
