@@ -6,6 +6,7 @@ Importing jaxcelt enables float64 in JAX (``jax_enable_x64``).
 """
 
 from . import _config  # noqa: F401  (float64 on)
+from .attractors import AttractorCensus, AttractorStarts, attractor_starts, attractors
 from .celt_orbit import CeltOrbit, continue_orbit, periodic_orbit
 from .contact import CONTACT_LAWS, AbstractContactLaw, Coulomb, CoulombSpin, GeneralisedPade, Pade, get_contact_law
 from .data import MeasuredData, Trajectory, generate_data, load_data, save_data
@@ -25,6 +26,10 @@ from .sweep import SweepResult, bifurcation, continuation, parameter_map
 __version__ = "0.1.0"
 
 __all__ = [
+    "AttractorCensus",
+    "AttractorStarts",
+    "attractor_starts",
+    "attractors",
     "CeltOrbit",
     "periodic_orbit",
     "continue_orbit",

@@ -51,6 +51,16 @@ def _lambda14() -> tuple[float, float]:
     return min(lam), max(lam)
 
 
+def _long14() -> str:
+    rows = {r["kind"]: r for r in _json("docs/orbits/census_long14/census.json")["results"]["14"]["attractors"]}
+    c, i, q = rows["chaotic"], rows["invalid"], rows["quasi-periodic"]
+    periodic = "none periodic" if "periodic" not in rows else "some periodic"
+    return (
+        f"chaotic {c['fraction']:.3f} (median λ₁ {c['lyapunov']:.3f} s⁻¹), invalid {i['fraction']:.3f}, "
+        f"quasi-periodic {q['fraction']:.3f}, and {periodic}"
+    )
+
+
 # (document, quoted text computed from the result file)
 QUOTES = [
     # main job and the full-size CLI run (summary.json written by `jaxcelt bifurcation`)
@@ -141,6 +151,19 @@ QUOTES = [
         "docs/bifurcation/README.md",
         lambda: f"| {_json('docs/bifurcation/step_parts.json')['us_per_lane']['diffrax tsit5 step + monitor']:.2f} |",
     ),
+    # attractor census (scripts/attractor_census.py)
+    (
+        "docs/orbits/README.md",
+        lambda: "at 14 rad/s {} s vs {} s".format(*_json("docs/orbits/census.json")["results"]["14"]["chunk_wall_s"]),
+    ),
+    (
+        "docs/orbits/README.md",
+        lambda: "load average {:.2f}–{:.2f}".format(
+            min(r["load_average_start"][0] for r in _json("docs/orbits/census.json")["results"].values()),
+            max(r["load_average_start"][0] for r in _json("docs/orbits/census.json")["results"].values()),
+        ),
+    ),
+    ("docs/orbits/README.md", lambda: _long14()),
     # paper reproduction (scripts/paper_study.py, scripts/paper_figures.py)
     ("README.md", lambda: f"{len(_starts())} initial conditions"),
     ("docs/paper-reproduction.md", lambda: f"{len(_starts())} starts"),
@@ -159,6 +182,17 @@ def test_quoted_number_matches_its_result_file(doc, quote):
     text = " ".join(_text(doc).split())  # line breaks in prose are spaces
     expected = quote()
     assert expected in text, f"{doc} should quote {expected!r} (from its result file)"
+
+
+def test_attractor_census_table_from_census_json():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("attractor_census", ROOT / "scripts" / "attractor_census.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    text = _text("docs/orbits/README.md")
+    for line in mod.markdown_table(_json("docs/orbits/census.json")).splitlines():
+        assert line in text, f"docs/orbits/README.md should contain {line!r} (from census.json)"
 
 
 def test_heading_study_has_sixteen_headings_and_a_roll():
