@@ -41,7 +41,7 @@ from jax.flatten_util import ravel_pytree
 
 from . import _config  # noqa: F401
 from ._types import Array, Scalar
-from .periodic import sort_multipliers, stroboscopic_map
+from .periodic import Chart, sort_multipliers, stroboscopic_map
 
 __all__ = [
     "BIFURCATION_POINT_KINDS",
@@ -63,7 +63,7 @@ class BifurcationPoint(eqx.Module):
     y: Array
     """orbit state at the section time (differentiable in theta)"""
     residual: Scalar
-    """max-norm of P(y) - y at the returned point"""
+    """max-norm of chart(P(y)) - chart(y) at the returned point (local coordinates)"""
     test: Scalar
     """bordered test function g at the returned point (0 at the bifurcation)"""
     multipliers: Array
@@ -94,6 +94,8 @@ def locate_bifurcation(
     kind: str = "period-doubling",
     k: int = 1,
     t0: float = 0.0,
+    embed: Chart | None = None,
+    chart: Chart | None = None,
     solver: diffrax.AbstractSolver | None = None,
     rtol: float = 1e-11,
     atol: float = 1e-12,
@@ -112,6 +114,10 @@ def locate_bifurcation(
         theta: pytree of float arrays, the parameters the point is differentiated in.
         kind: ``"period-doubling"`` (a multiplier at -1) or ``"fold"`` (+1).
         k, t0, solver, rtol, atol, max_steps: as in `jaxcelt.periodic.stroboscopic_map`.
+        embed, chart: local coordinates around ``y_guess`` as in
+            `jaxcelt.periodic.find_periodic_orbit` (default identity); the periodicity condition
+            and the monodromy M are taken in them (a model with constraints or cyclic
+            coordinates needs them: its trivial multipliers at 1 would make every point a fold).
         newton_tol: Newton tolerance on z = (y, lam) (optimistix rtol = atol).
         newton_max_steps: Newton iterations at most.
 
@@ -126,23 +132,40 @@ def locate_bifurcation(
     y_guess = jnp.asarray(y_guess, dtype=float)
     if y_guess.ndim != 1:
         raise ValueError(f"y_guess must be a 1-D state, got shape {y_guess.shape}")
-    n = y_guess.shape[0]
+    if embed is None:
+        embed = lambda w, ref, a: w  # noqa: E731
+    if chart is None:
+        chart = lambda y, ref, a: y  # noqa: E731
+    ref = jax.lax.stop_gradient(y_guess)
     theta_flat, unravel = ravel_pytree(theta)
     theta_flat = jnp.asarray(theta_flat, dtype=float)
+    w_guess = chart(ref, ref, args_of(jnp.asarray(lam_guess, dtype=float), unravel(jax.lax.stop_gradient(theta_flat))))
+    n = w_guess.shape[0]
     eye = jnp.eye(n, dtype=y_guess.dtype)
 
-    def map_and_monodromy(y, lam, th):
+    def map_and_monodromy(w, lam, th):
+        """(chart(P(embed(w))), its Jacobian in w, success), all in local coordinates."""
         args = args_of(lam, unravel(th))
         T = period_of(args)
 
-        def P(yy):
+        def P(ww):
             y1, ok, _ = stroboscopic_map(
-                vector_field, yy, args, period=T, k=k, t0=t0, solver=solver, rtol=rtol, atol=atol, max_steps=max_steps
+                vector_field,
+                embed(ww, ref, args),
+                args,
+                period=T,
+                k=k,
+                t0=t0,
+                solver=solver,
+                rtol=rtol,
+                atol=atol,
+                max_steps=max_steps,
             )
-            return y1, (y1, ok)
+            w1 = chart(y1, ref, args)
+            return w1, (w1, ok)
 
-        M, (y1, ok) = jax.jacfwd(P, has_aux=True)(y)
-        return y1, M, ok
+        M, (w1, ok) = jax.jacfwd(P, has_aux=True)(w)
+        return w1, M, ok
 
     def F(z, th, b, c):
         y, lam = z[:n], z[n]
@@ -171,7 +194,7 @@ def locate_bifurcation(
         return z, dz
 
     th0 = jax.lax.stop_gradient(theta_flat)
-    z0 = jnp.concatenate([jax.lax.stop_gradient(y_guess), jnp.asarray(lam_guess, dtype=float)[None]])
+    z0 = jnp.concatenate([w_guess, jnp.asarray(lam_guess, dtype=float)[None]])
     z0 = jax.lax.stop_gradient(z0)
     b0, c0 = bordering_at(z0, th0)
     sol = optx.root_find(
@@ -194,7 +217,7 @@ def locate_bifurcation(
     z = attach_ift(z_root, theta_flat)
     return BifurcationPoint(
         value=z[n],
-        y=z[:n],
+        y=embed(z[:n], ref, args_of(z[n], unravel(theta_flat))),
         residual=res,
         test=g,
         multipliers=sort_multipliers(mu),

@@ -44,7 +44,15 @@ from .state import check_state
 GUESS_MANIFOLD_TOL = 1e-3
 """How far (|n| - 1, v_A . n, r_C3 + rho . n) a guess may be off the contact manifold."""
 
-__all__ = ["CeltOrbit", "periodic_orbit", "continue_orbit", "celt_chart", "celt_embed", "ORBIT_STATUS"]
+__all__ = [
+    "CeltOrbit",
+    "periodic_orbit",
+    "continue_orbit",
+    "locate_orbit_bifurcation",
+    "celt_chart",
+    "celt_embed",
+    "ORBIT_STATUS",
+]
 
 
 def _basis(n0: Array) -> tuple[Array, Array]:
@@ -259,39 +267,80 @@ def continue_orbit(
     params: CeltParams,
     orbit: CeltOrbit,
     name: str,
-    values: ArrayLike,
+    stop: float | tuple[float, float],
     *,
+    ds: float = 0.05,
+    ds_min: float = 1e-4,
+    ds_max: float = 0.3,
+    max_points: int = 300,
     contact_law: AbstractContactLaw | str | None = None,
     solver: diffrax.AbstractSolver | None = None,
     rtol: float = 1e-11,
     atol: float = 1e-12,
     max_steps: int = 200_000,
     newton_tol: float = 1e-9,
-    locate: bool = True,
+    bisections: int = 30,
+    callback=None,
 ):
-    """Follow ``orbit`` (found at ``params``) in the parameter ``name`` over ``values``.
+    """Follow ``orbit`` (found at ``params``) in the parameter ``name`` to ``stop``.
 
-    Natural continuation with period-doubling / fold / Neimark-Sacker detection
-    (`jaxcelt.orbit_continuation.continue_periodic_orbit`); the section is t0 = 0 (the field
-    depends on t only through the base's phase omega_pi t, so an orbit found at t0 = m T is
-    the same section). ``values[0]`` should be the orbit's own parameter value.
+    Pseudo-arclength continuation in the 8 chart coordinates of the contact manifold plus the
+    parameter (`jaxcelt.orbit_continuation.continue_pseudo_arclength`, the chart re-centred on
+    every point), so the branch passes folds; folds, period doublings (bisected) and
+    Neimark-Sacker points are reported in ``bifurcations``. The section is t0 = 0 (the field
+    depends on t only through the base's phase omega_pi t, so an orbit found at t0 = m T is the
+    same section point).
+
+    Args:
+        params: parameters of ``orbit`` (its value of ``name`` is the start).
+        orbit: a converged `CeltOrbit` (`periodic_orbit`).
+        name: a scalar `CeltParams` field (omega_pi, q_pi, mu, ...).
+        stop: the branch ends once it passes this value of ``name``; or a window ``(lo, hi)``
+            around the start: the branch is followed both ways until each end leaves it (it
+            may turn at a fold and come back on another sheet).
+        ds, ds_min, ds_max, max_points: arclength step control (coordinates: m/s, rad/s, rad,
+            and the parameter's own unit).
+        callback: ``callback(n_points, value, accepted)`` after every corrector attempt.
+
+    Returns:
+        `jaxcelt.orbit_continuation.ArclengthBranch` (``y``: states at the section t0 = 0).
     """
-    from .orbit_continuation import continue_periodic_orbit
+    from .orbit_continuation import continue_pseudo_arclength
 
-    if name not in CeltParams.__dataclass_fields__:
-        raise ValueError(f"continue_orbit: 'name' must be a CeltParams field, got {name!r}")
+    if not isinstance(params, CeltParams):
+        raise TypeError(f"params must be a CeltParams, got {type(params).__name__}")
+    if name not in CeltParams.__dataclass_fields__ or np.ndim(getattr(params, name)) != 0:
+        raise ValueError(f"continue_orbit: 'name' must be a scalar CeltParams field, got {name!r}")
+    if int(np.max(np.asarray(orbit.status))) != 0 or np.ndim(orbit.status) != 0:
+        raise ValueError("continue_orbit: 'orbit' must be one converged orbit (status 0)")
+    lam0 = float(getattr(params, name))
+    st = np.asarray(stop, dtype=float)
+    if st.ndim == 1 and st.shape == (2,) and np.all(np.isfinite(st)):
+        if not st[0] < lam0 < st[1]:
+            raise ValueError(f"continue_orbit: 'stop' window must contain {name} = {lam0}, got {stop!r}")
+        stop = (float(st[0]), float(st[1]))
+    elif st.ndim != 0 or not np.isfinite(st) or float(st) == lam0:
+        raise ValueError(
+            f"continue_orbit: 'stop' must be a finite value other than {name} = {lam0} or a window, got {stop!r}"
+        )
+    else:
+        stop = float(st)
     law = get_contact_law(contact_law)
 
     def args_of(lam):
         return eqx.tree_at(lambda p: getattr(p, name), params, jnp.asarray(lam, float))
 
-    return continue_periodic_orbit(
+    return continue_pseudo_arclength(
         _Field(law),
         orbit.y,
         args_of,
         lambda p: 2 * jnp.pi / p.omega_pi,
-        np.asarray(values, dtype=float),
-        locate=locate,
+        lam0,
+        stop,
+        ds=ds,
+        ds_min=ds_min,
+        ds_max=ds_max,
+        max_points=max_points,
         k=orbit.k,
         embed=celt_embed,
         chart=celt_chart,
@@ -300,4 +349,77 @@ def continue_orbit(
         atol=atol,
         max_steps=max_steps,
         newton_tol=newton_tol,
+        bisections=bisections,
+        callback=callback,
+    )
+
+
+def locate_orbit_bifurcation(
+    params: CeltParams,
+    y_guess: ArrayLike,
+    name: str,
+    value_guess: float,
+    *,
+    kind: str = "fold",
+    wrt: tuple[str, ...] = ("mu", "k_r", "b_Ts", "m_Ts"),
+    k: int = 1,
+    contact_law: AbstractContactLaw | str | None = None,
+    solver: diffrax.AbstractSolver | None = None,
+    rtol: float = 1e-11,
+    atol: float = 1e-12,
+    max_steps: int = 200_000,
+    newton_tol: float = 1e-10,
+    newton_max_steps: int = 30,
+):
+    """Refine a fold or period doubling of a wobblestone orbit in ``name``; differentiable in ``wrt``.
+
+    `jaxcelt.bifurcation_point.locate_bifurcation` in the chart of the contact manifold
+    (`celt_chart`, section t0 = 0): Newton on (periodicity, bordered det(M -+ I) = 0) for the
+    orbit state and the value of ``name``. ``jax.grad`` of the result's ``value`` (or ``y``)
+    with respect to the fields ``wrt`` of ``params`` is the implicit-function-theorem derivative
+    of the located point, e.g. ``jax.grad(lambda mu: locate_orbit_bifurcation(
+    eqx.tree_at(lambda p: p.mu, params, mu), y, "omega_pi", 14.88).value)(params.mu)``.
+
+    Args:
+        params: the stone; its ``name`` field is replaced by the located value.
+        y_guess, value_guess: a nearby orbit state at t0 = 0 and value of ``name`` (e.g. a
+            ``Bifurcation`` of `continue_orbit`: ``b.y``, ``b.value``).
+        name: the bifurcation parameter (a scalar `CeltParams` field).
+        kind: ``"fold"`` (a multiplier at +1) or ``"period-doubling"`` (-1).
+        wrt: the fields derivatives are carried for (the others are constants).
+    """
+    from .bifurcation_point import locate_bifurcation
+
+    if not isinstance(params, CeltParams):
+        raise TypeError(f"params must be a CeltParams, got {type(params).__name__}")
+    for n in (name, *wrt):
+        if n not in CeltParams.__dataclass_fields__:
+            raise ValueError(f"locate_orbit_bifurcation: {n!r} is not a CeltParams field")
+    if name in wrt:
+        raise ValueError(f"locate_orbit_bifurcation: 'wrt' must not contain the bifurcation parameter {name!r}")
+    check_state(y_guess, params, name="y_guess", tol=GUESS_MANIFOLD_TOL)
+    law = get_contact_law(contact_law)
+    theta = {n: jnp.asarray(getattr(params, n), float) for n in wrt}
+
+    def args_of(lam, th):
+        names = (name, *th)
+        return eqx.tree_at(lambda p: [getattr(p, n) for n in names], params, [lam, *th.values()])
+
+    return locate_bifurcation(
+        _Field(law),
+        jnp.asarray(y_guess, float),
+        value_guess,
+        args_of,
+        lambda p: 2 * jnp.pi / p.omega_pi,
+        theta,
+        kind=kind,
+        k=k,
+        embed=celt_embed,
+        chart=celt_chart,
+        solver=solver or diffrax.Dopri8(),
+        rtol=rtol,
+        atol=atol,
+        max_steps=max_steps,
+        newton_tol=newton_tol,
+        newton_max_steps=newton_max_steps,
     )

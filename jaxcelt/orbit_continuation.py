@@ -30,6 +30,7 @@ import optimistix as optx
 
 from ._types import Array
 from .periodic import (
+    Chart,
     PeriodicOrbit,
     find_periodic_orbit,
     sort_multipliers,
@@ -44,6 +45,7 @@ __all__ = [
     "continue_periodic_orbit",
     "continue_pseudo_arclength",
     "switch_at_period_doubling",
+    "branch_to_dict",
     "BIFURCATION_KINDS",
 ]
 
@@ -179,13 +181,29 @@ def continue_periodic_orbit(
     )
 
 
+def _ns_function(mu: np.ndarray) -> float:
+    """max |mu| - 1 over the complex multipliers (its zero is a Neimark-Sacker point)."""
+    cplx = np.abs(mu.imag) > _IMAG_TOL
+    return float(np.max(np.abs(mu[cplx])) - 1.0) if np.any(cplx) else -1.0
+
+
+def _pd_function(mu: np.ndarray) -> float:
+    return _test_functions(mu)["period-doubling"]
+
+
+_BISECTED = {"period-doubling": _pd_function, "Neimark-Sacker": _ns_function}
+"""crossings located by bisection in lam (folds: interpolation of the tangent's lam-component,
+since at a fold no orbit exists past it at fixed lam)"""
+
+
 class ArclengthBranch(NamedTuple):
     values: np.ndarray
     """parameter values of the converged points (m,), not monotonic past a fold"""
     y: np.ndarray
     """orbit states (m, n)"""
     tangents: np.ndarray
-    """unit tangents (m, n + 1) in (y, lam), oriented along the branch"""
+    """unit tangents (m, d + 1) in (z, lam), each in the chart around its own point, oriented
+    along the branch"""
     multipliers: np.ndarray
     """Floquet multipliers (m, n), by decreasing modulus"""
     stable: np.ndarray
@@ -194,21 +212,25 @@ class ArclengthBranch(NamedTuple):
     """arclength step that reached each point (m,) (0 for the first)"""
     bifurcations: list[Bifurcation]
     """crossings between consecutive points, in branch order. ``value``: period doublings
-    bisected in lam on Re prod(1 + mu); folds and NS interpolated linearly between the
-    bracketing points (folds in the lam-component of the tangent), accurate to about the local
-    step squared"""
+    bisected in lam on Re prod(1 + mu), Neimark-Sacker points on max |mu| - 1 of the complex
+    multipliers; folds interpolated linearly in the lam-component of the tangent between the
+    bracketing points (accurate to about the local step squared)"""
     stopped: str
-    """why the branch ended: "end value reached", "max points" or "step below ds_min"."""
+    """why the branch ended: "end value reached", "max points" or "step below ds_min" (for a
+    window, one reason for each end)"""
+    start: int = 0
+    """index of the starting point (``y_guess``'s orbit) in the branch"""
 
 
-def _bisect_pd(solve, ua, ub, tf_a, bisections):
+def _bisect(solve, ua, ub, tf_of, tf_a, bisections):
+    """Bisect [ua, ub] (rows (y, lam)) on the sign of ``tf_of(multipliers)``; Newton at fixed lam."""
     lo, hi, y_lo, y_hi = ua[-1], ub[-1], ua[:-1], ub[:-1]
     for _ in range(bisections):
         mid = 0.5 * (lo + hi)
         orb = solve(jnp.asarray(mid), jnp.asarray(0.5 * (y_lo + y_hi)))
         if int(orb.status) != 0:
             break
-        tf = _test_functions(np.asarray(orb.multipliers))["period-doubling"]
+        tf = tf_of(np.asarray(orb.multipliers))
         if np.sign(tf) == np.sign(tf_a):
             lo, y_lo = mid, np.asarray(orb.y)
         else:
@@ -224,7 +246,7 @@ def continue_pseudo_arclength(
     args_of: Callable[[Array], Any],
     period_of: Callable[[Any], Array],
     lam0: float,
-    lam_end: float,
+    lam_end: float | tuple[float, float],
     *,
     ds: float = 0.02,
     ds_min: float = 1e-5,
@@ -232,141 +254,203 @@ def continue_pseudo_arclength(
     max_points: int = 400,
     k: int = 1,
     t0: float = 0.0,
+    embed: Chart | None = None,
+    chart: Chart | None = None,
+    solver: Any = None,
     rtol: float = 1e-10,
     atol: float = 1e-11,
     max_steps: int = 100_000,
     newton_tol: float = 1e-9,
     newton_max_steps: int = 8,
     bisections: int = 30,
+    callback: Callable[[int, float, bool], None] | None = None,
 ) -> ArclengthBranch:
     """Pseudo-arclength continuation of the period-k orbit through ``y_guess`` at ``lam0``.
 
-    Unknowns u = (y, lam); each point solves (optimistix Newton) the augmented system
-    P^k(y; lam) - y = 0, t . (u - u_prev) - ds = 0 from the tangent predictor
-    u_prev + ds t, where t is the unit null vector of [dP/dy - I, dP/dlam] (oriented like the
-    previous tangent). Because lam is an unknown, the branch passes folds in lam. The step is
-    halved when Newton fails and grown x1.5 (up to ``ds_max``) when it converges in at most 3
-    iterations. Multipliers come from the variational equations (`variational_map`).
+    Unknowns u = (z, lam) with z = chart(y) local coordinates (the state itself by default);
+    each point solves (optimistix Newton) the augmented system chart(P^k(embed(z); lam)) - z = 0,
+    t . (u - u_prev) - ds = 0 from the tangent predictor u_prev + ds t, where t is the unit null
+    vector of [dG/dz, dG/dlam] (oriented like the previous tangent). Because lam is an unknown,
+    the branch passes folds in lam. The chart is re-centred on every accepted point (the
+    previous tangent is carried over by the chain rule), so a branch may travel far from where
+    it started. The step is halved when Newton fails and grown x1.5 (up to ``ds_max``) when it
+    converges in at most 3 iterations. Multipliers come from the variational equations
+    (`variational_map`), in chart coordinates.
 
     Args:
         vector_field, args_of, period_of: as in `continue_periodic_orbit`.
-        lam0, lam_end: start value and the value at which the branch stops (once passed).
-        ds, ds_min, ds_max: initial, smallest and largest arclength step in (y, lam).
-        max_points: points at most.
-        bisections: halvings of the lam-bracket of each period doubling (a Newton solve in
-            lam at fixed lam each, from the interpolated state; 0: linear interpolation only).
+        lam0: start value (the parameter of ``y_guess``).
+        lam_end: the value at which the branch stops (once passed), or a window ``(lo, hi)``
+            around lam0: the branch is followed both ways from lam0 until each end leaves the
+            window (it may turn at folds and come back through lam0 on another sheet).
+        ds, ds_min, ds_max: initial, smallest and largest arclength step in (z, lam).
+        max_points: points at most (shared by the two ends of a window).
+        embed, chart: local coordinates as in `jaxcelt.periodic.find_periodic_orbit`
+            (``embed(z, y_ref, args)``, ``chart(y, y_ref, args)``); default identity.
+        solver: diffrax solver (default Dopri8).
+        bisections: halvings of the lam-bracket of each period doubling (a Newton solve at
+            fixed lam each, from the interpolated state; 0: linear interpolation only).
+        callback: called as ``callback(n_points, lam, accepted)`` after every corrector attempt
+            (e.g. a progress bar).
 
     Returns:
-        `ArclengthBranch` (host arrays).
+        `ArclengthBranch` (host arrays; ``y`` are states, ``tangents`` in the chart of each point).
     """
-    ode = dict(k=k, t0=t0, rtol=rtol, atol=atol, max_steps=max_steps)
-    direction = np.sign(lam_end - lam0)
-    if direction == 0:
+    ode = dict(k=k, t0=t0, solver=solver, rtol=rtol, atol=atol, max_steps=max_steps)
+    window = None
+    if np.ndim(lam_end) == 1:
+        window = tuple(float(x) for x in lam_end)
+        if len(window) != 2 or not (window[0] < lam0 < window[1]):
+            raise ValueError(f"lam_end: a window (lo, hi) must have lo < lam0 < hi, got {lam_end!r} (lam0={lam0})")
+    elif np.sign(lam_end - lam0) == 0:
         raise ValueError("lam_end must differ from lam0")
+    if embed is None:
+        embed = lambda z, ref, a: z  # noqa: E731
+    if chart is None:
+        chart = lambda y, ref, a: y  # noqa: E731
 
-    def P_minus(u):
-        y, lam = u[:-1], u[-1]
+    def G(u, ref):
+        z, lam = u[:-1], u[-1]
         args = args_of(lam)
-        y1, ok, _ = stroboscopic_map(vector_field, y, args, period=period_of(args), **ode)
-        return y1 - y, ok
+        y1, ok, _ = stroboscopic_map(vector_field, embed(z, ref, args), args, period=period_of(args), **ode)
+        return chart(y1, ref, args) - z, ok
 
     @jax.jit
-    def tangent(u, t_prev):
-        J = jax.jacfwd(lambda v: P_minus(v)[0])(u)
+    def tangent(u, ref, t_prev):
+        J = jax.jacfwd(lambda v: G(v, ref)[0])(u)
         _, _, vt = jnp.linalg.svd(J)
         t = vt[-1]
         return t * jnp.sign(jnp.dot(t, t_prev) + 1e-300)
 
     @jax.jit
-    def corrector(u_prev, t, h):
+    def recentre(u, t, ref):
+        """(u, t) in the chart around the state of u (the new reference) and that state."""
+        args = args_of(u[-1])
+        y = embed(u[:-1], ref, args)
+
+        def to_new(v):
+            a = args_of(v[-1])
+            return jnp.concatenate([chart(embed(v[:-1], ref, a), y, a), v[-1:]])
+
+        u_new, t_new = jax.jvp(to_new, (u,), (t,))
+        return u_new, t_new / jnp.linalg.norm(t_new), y
+
+    @jax.jit
+    def corrector(u_prev, t, h, ref):
         pred = u_prev + h * t
 
         def fn(u, _):
-            return jnp.concatenate([P_minus(u)[0], jnp.dot(t, u - u_prev)[None] - h])
+            return jnp.concatenate([G(u, ref)[0], jnp.dot(t, u - u_prev)[None] - h])
 
         finder = optx.Newton(rtol=newton_tol, atol=newton_tol)
         sol = optx.root_find(fn, finder, pred, max_steps=newton_max_steps, throw=False)
         u = sol.value
-        res, ok = P_minus(u)
-        good = (sol.result == optx.RESULTS.successful) & ok & (jnp.max(jnp.abs(res)) < 10 * newton_tol)
+        res, ok = G(u, ref)
+        good = (sol.result == optx.RESULTS.successful) & ok & jnp.all(jnp.isfinite(u))
+        good = good & (jnp.max(jnp.abs(res)) < 10 * newton_tol)
         return u, good, sol.stats["num_steps"]
 
     @jax.jit
-    def floquet(u):
-        args = args_of(u[-1])
-        _, Phi, _, _ = variational_map(vector_field, u[:-1], args, period=period_of(args), **ode)
-        return sort_multipliers(jnp.linalg.eigvals(Phi))
+    def floquet(u, ref):
+        z, lam = u[:-1], u[-1]
+        args = args_of(lam)
+        y = embed(z, ref, args)
+        y1, Phi, _, _ = variational_map(vector_field, y, args, period=period_of(args), **ode)
+        E = jax.jacfwd(lambda zz: embed(zz, ref, args))(z)
+        C = jax.jacfwd(lambda yy: chart(yy, ref, args))(y1)
+        return sort_multipliers(jnp.linalg.eigvals(C @ Phi @ E))
+
+    fkw = dict(ode, embed=embed, chart=chart, newton_tol=newton_tol)
 
     @jax.jit
     def first(lam, y0):
         args = args_of(lam)
-        return find_periodic_orbit(vector_field, y0, args, period=period_of(args), newton_tol=newton_tol, **ode)
+        return find_periodic_orbit(vector_field, y0, args, period=period_of(args), **fkw)
 
     orb = first(jnp.asarray(lam0, float), jnp.asarray(y_guess, float))
     if int(orb.status) != 0:
         raise ValueError(f"y_guess: no period-{k} orbit found near it at lam0={lam0}")
-    n = orb.y.shape[0]
-    u = jnp.concatenate([orb.y, jnp.asarray([lam0], float)])
-    t = tangent(u, jnp.zeros(n + 1).at[-1].set(direction))
-    us, ts, mus, hs = [np.asarray(u)], [np.asarray(t)], [np.asarray(floquet(u))], [0.0]
-    h = ds
-    stopped = "max points"
-    while len(us) < max_points:
-        u_new, good, nsteps = corrector(u, t, h)
-        if not bool(good):
-            h *= 0.5
-            if h < ds_min:
-                stopped = "step below ds_min"
-                break
-            continue
-        t = tangent(u_new, t)
-        u = u_new
-        us.append(np.asarray(u))
-        ts.append(np.asarray(t))
-        mus.append(np.asarray(floquet(u)))
-        hs.append(h)
-        if int(nsteps) <= 3:
-            h = min(1.5 * h, ds_max)
-        if (float(u[-1]) - lam_end) * direction >= 0:
-            stopped = "end value reached"
-            break
+    z0 = chart(orb.y, orb.y, args_of(jnp.asarray(lam0, float)))
+    u0 = jnp.concatenate([z0, jnp.asarray([lam0], float)])
+    mu0 = np.asarray(floquet(u0, orb.y))
 
-    U, TT, MU = np.asarray(us), np.asarray(ts), np.asarray(mus)
+    def trace(direction, passed, budget):
+        """Points after the start, following the branch from lam0 in ``direction``."""
+        ref, u = orb.y, u0
+        t = tangent(u, ref, jnp.zeros(u.shape[0]).at[-1].set(direction))
+        out = dict(y=[], lam=[], t=[np.asarray(t)], mu=[], h=[])
+        h, stopped = ds, "max points"
+        while len(out["y"]) < budget:
+            u_new, good, nsteps = corrector(u, t, h, ref)
+            if callback is not None:
+                callback(len(out["y"]) + 1, float(u_new[-1]) if bool(good) else float(u[-1]), bool(good))
+            if not bool(good):
+                h *= 0.5
+                if h < ds_min:
+                    stopped = "step below ds_min"
+                    break
+                continue
+            u, t, ref = recentre(u_new, t, ref)
+            t = tangent(u, ref, t)
+            out["y"].append(np.asarray(ref))
+            out["lam"].append(float(u[-1]))
+            out["t"].append(np.asarray(t))
+            out["mu"].append(np.asarray(floquet(u, ref)))
+            out["h"].append(h)
+            if int(nsteps) <= 3:
+                h = min(1.5 * h, ds_max)
+            if passed(out["lam"][-1]):
+                stopped = "end value reached"
+                break
+        return out, stopped
+
+    if window is None:
+        direction = np.sign(lam_end - lam0)
+        fwd, stopped = trace(direction, lambda lam: (lam - lam_end) * direction >= 0, max_points - 1)
+        bwd = dict(y=[], lam=[], t=[np.asarray(fwd["t"][0])], mu=[], h=[])
+    else:
+        lo, hi = window
+        outside = lambda lam: not (lo <= lam <= hi)  # noqa: E731
+        bwd, s_lo = trace(-1.0, outside, (max_points - 1) // 2)
+        fwd, s_hi = trace(1.0, outside, max_points - 1 - len(bwd["y"]))
+        stopped = f"decreasing end: {s_lo}; increasing end: {s_hi}"
+    # one branch ordered along the arclength: the backward part reversed (tangents flipped)
+    ys = bwd["y"][::-1] + [np.asarray(orb.y)] + fwd["y"]
+    lams = bwd["lam"][::-1] + [float(lam0)] + fwd["lam"]
+    ts = [-x for x in bwd["t"][1:][::-1]] + [np.asarray(fwd["t"][0])] + fwd["t"][1:]
+    mus = bwd["mu"][::-1] + [mu0] + fwd["mu"]
+    hs = bwd["h"][::-1] + [0.0] + fwd["h"]
+
+    Y, LAM, TT, MU = np.asarray(ys), np.asarray(lams), np.asarray(ts), np.asarray(mus)
     bifs: list[Bifurcation] = []
-    for i in range(1, len(U)):
+    for i in range(1, len(Y)):
         ta, tb = _test_functions(MU[i - 1]), _test_functions(MU[i])
         checks = {
             "fold": (TT[i - 1, -1], TT[i, -1]),
             "period-doubling": (ta["period-doubling"], tb["period-doubling"]),
         }
-        for kind, (a, b) in checks.items():
-            if np.sign(a) != np.sign(b):
-                w = a / (a - b)
-                val = (1 - w) * U[i - 1, -1] + w * U[i, -1]
-                mu = (1 - w) * MU[i - 1] + w * MU[i]
-                y = (1 - w) * U[i - 1, :-1] + w * U[i, :-1]
-                if kind == "period-doubling" and bisections:
-                    val, mu, y = _bisect_pd(first, U[i - 1], U[i], a, bisections)
-                bifs.append(Bifurcation(kind, float(val), (U[i - 1, -1], U[i, -1]), mu, y))
         if ta["Neimark-Sacker"] != tb["Neimark-Sacker"]:
-            bifs.append(
-                Bifurcation(
-                    "Neimark-Sacker",
-                    float(0.5 * (U[i - 1, -1] + U[i, -1])),
-                    (U[i - 1, -1], U[i, -1]),
-                    MU[i],
-                    U[i, :-1],
-                )
-            )
+            checks["Neimark-Sacker"] = (_ns_function(MU[i - 1]), _ns_function(MU[i]))
+        for kind, (a, b) in checks.items():
+            if np.sign(a) != np.sign(b) or kind == "Neimark-Sacker":
+                w = float(np.clip(a / (a - b), 0.0, 1.0)) if a != b else 0.5
+                val = (1 - w) * LAM[i - 1] + w * LAM[i]
+                mu = (1 - w) * MU[i - 1] + w * MU[i]
+                y = (1 - w) * Y[i - 1] + w * Y[i]
+                if kind in _BISECTED and bisections:
+                    ua, ub = np.r_[Y[i - 1], LAM[i - 1]], np.r_[Y[i], LAM[i]]
+                    val, mu, y = _bisect(first, ua, ub, _BISECTED[kind], a, bisections)
+                bifs.append(Bifurcation(kind, float(val), (LAM[i - 1], LAM[i]), mu, y))
     return ArclengthBranch(
-        values=U[:, -1],
-        y=U[:, :-1],
+        values=LAM,
+        y=Y,
         tangents=TT,
         multipliers=MU,
         stable=np.all(np.abs(MU) < 1.0, axis=1),
         steps=np.asarray(hs),
         bifurcations=bifs,
         stopped=stopped,
+        start=len(bwd["y"]),
     )
 
 
@@ -407,3 +491,35 @@ def switch_at_period_doubling(
             if float(jnp.max(jnp.abs(y1 - orb.y))) > eps / 10:
                 return orb
     return orb
+
+
+def _complex_pairs(mu: np.ndarray) -> list[list[float]]:
+    return [[float(z.real), float(z.imag)] for z in np.asarray(mu)]
+
+
+def branch_to_dict(branch: ArclengthBranch, state_names: tuple[str, ...] | None = None) -> dict[str, Any]:
+    """A JSON-ready dict of a branch: per point the parameter, state, |mu|max and stability; the
+    bifurcations with their multipliers (complex as [re, im] pairs)."""
+    y = np.asarray(branch.y)
+    names = state_names or tuple(f"y{i}" for i in range(y.shape[1]))
+    mu = np.asarray(branch.multipliers)
+    return {
+        "values": [float(v) for v in branch.values],
+        "state": {n: [float(v) for v in y[:, i]] for i, n in enumerate(names)},
+        "max_abs_multiplier": [float(v) for v in np.max(np.abs(mu), axis=1)],
+        "multipliers": [_complex_pairs(m) for m in mu],
+        "stable": [bool(s) for s in branch.stable],
+        "start": int(branch.start),
+        "stopped": branch.stopped,
+        "bifurcations": [
+            {
+                "kind": b.kind,
+                "value": float(b.value),
+                "bracket": [float(b.bracket[0]), float(b.bracket[1])],
+                "multipliers": _complex_pairs(b.multipliers),
+                "multipliers_abs": [float(a) for a in np.abs(b.multipliers)],
+                "state": dict(zip(names, map(float, np.asarray(b.y)), strict=True)),
+            }
+            for b in branch.bifurcations
+        ],
+    }

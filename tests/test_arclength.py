@@ -3,8 +3,11 @@
 Hardening Duffing x'' + 0.2 x' + x + x^3 = 0.3 cos(w t), period-1 frequency response continued
 in w from 0.8 to 2.5: the resonance curve bends right, so the branch turns back once (upper
 fold) and forward again (lower fold), giving a hysteresis window. Natural continuation in w
-stops at the first fold; the arclength branch must reach w = 2.5 and report exactly two
-folds. Independent check with scipy DOP853 (no Newton, no JAX): inside the window two initial
+stops at the first fold; the arclength branch, started at w = 1 inside the window (0.8, 2.5)
+and followed both ways, must reach both ends and report exactly two folds. It runs in a
+nonlinear chart z = (x - x_ref, v - v_ref - 0.3 (x - x_ref)^2), re-centred on every point, so
+the chart handling (tangent carried between charts) is exercised; the branch is a property of
+the ODE, not of the chart, and is checked against scipy in state coordinates. Independent check with scipy DOP853 (no Newton, no JAX): inside the window two initial
 conditions settle on two different period-1 attractors (section points repeat to 1e-6 after
 300 periods; Floquet multipliers there have modulus about exp(-0.1 T) ~ 0.6, so 0.6^300 is far
 below that), whose amplitudes match the stable points of the branch interpolated at that w to
@@ -34,20 +37,31 @@ def attractor(w, y0, periods=300):
     return s.y.T
 
 
+def embed(z, ref, a):
+    return jnp.stack([ref[0] + z[0], ref[1] + z[1] + 0.3 * z[0] ** 2])
+
+
+def chart(y, ref, a):
+    return jnp.stack([y[0] - ref[0], y[1] - ref[1] - 0.3 * (y[0] - ref[0]) ** 2])
+
+
 def test_arclength_passes_both_folds_of_hardening_duffing():
     br = continue_pseudo_arclength(
         duffing,
         jnp.array([0.5, 0.0]),
         lambda w: jnp.stack([C, F, w]),
         lambda a: 2 * jnp.pi / a[2],
-        0.8,
-        2.5,
+        1.0,
+        (0.8, 2.5),
         ds=0.05,
         ds_max=0.3,
         rtol=1e-9,
         atol=1e-10,
+        embed=embed,
+        chart=chart,
     )
-    assert br.stopped == "end value reached" and br.values[-1] >= 2.5
+    assert br.stopped == "decreasing end: end value reached; increasing end: end value reached", br.stopped
+    assert br.values[0] < 0.8 and br.values[-1] > 2.5 and br.values[br.start] == 1.0
     folds = [b.value for b in br.bifurcations if b.kind == "fold"]
     assert len(folds) == 2
     hi, lo = folds  # upper fold met first, then the lower one

@@ -71,18 +71,27 @@ def test_period_one_orbit_at_15_6_against_scipy_fd_and_lyapunov():
 
 @pytest.mark.slow
 def test_continue_orbit_in_omega_pi_is_smooth():
-    # a short step of the 15.6 rad/s orbit in omega_pi: every point converges, multipliers move
-    # continuously (|mu| changes < 0.05 per 0.05 rad/s) and nothing crosses the unit circle
+    # a short stretch of the 15.6 rad/s orbit in omega_pi: the branch reaches 15.9, multipliers
+    # move continuously (|mu| changes < 0.05 between points at most 0.3 apart in arclength) and
+    # nothing crosses the unit circle; the branch's orbit at a point is a periodic orbit by an
+    # independent Newton solve (periodic_orbit from that point at that omega_pi, 1e-8)
     spec = importlib.util.spec_from_file_location("orbit_check", ROOT / "scripts" / "orbit_check.py")
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     p = jc.CeltParams.paper(omega_pi=15.6)
     yg, t0 = mod.guess(p)
     orb = jc.periodic_orbit(p, yg, t0=t0)
-    br = jc.continue_orbit(p, orb, "omega_pi", [15.6, 15.65, 15.7])
-    assert br.stopped_at is None and len(br.values) == 3
+    br = jc.continue_orbit(p, orb, "omega_pi", 15.9)
+    assert br.stopped == "end value reached" and br.values[-1] >= 15.9
+    assert np.all(np.diff(br.values) > 0)
     np.testing.assert_allclose(np.abs(br.multipliers[0]), np.abs(np.asarray(orb.multipliers)), atol=1e-8)
     assert np.max(np.abs(np.diff(np.abs(br.multipliers), axis=0))) < 0.05
     assert br.bifurcations == [] and bool(np.all(br.stable))
+    i = len(br.values) // 2
+    again = jc.periodic_orbit(jc.CeltParams.paper(omega_pi=float(br.values[i])), br.y[i], t0=0.0)
+    assert int(again.status) == 0
+    np.testing.assert_allclose(np.asarray(again.y), br.y[i], atol=1e-8)
     with pytest.raises(ValueError, match="'name'"):
-        jc.continue_orbit(p, orb, "nope", [15.6])
+        jc.continue_orbit(p, orb, "nope", 15.9)
+    with pytest.raises(ValueError, match="'stop'"):
+        jc.continue_orbit(p, orb, "omega_pi", (16.0, 20.0))

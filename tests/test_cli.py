@@ -61,6 +61,11 @@ BAD_INPUT = [
     (["fit", "missing.npz", "--set", "mu=-1"], "'mu'"),
     (["fit", "missing.npz", "--max-iter", "0"], "--max-iter"),
     (["fit", "missing.npz"], "missing.npz"),
+    (["orbits", "--continue", "20:10"], "--continue"),
+    (["orbits", "--continue", "16:20"], "--continue"),
+    (["orbits", "--param", "nonsense", "--continue", "1:2"], "--param"),
+    (["orbits", "--set", "mu=-1"], "'mu'"),
+    (["orbits", "--k", "0"], "--k"),
 ]
 
 
