@@ -426,24 +426,28 @@ RESULT_FILES: tuple[str, ...] = (
 )
 
 
-def results_dir() -> Any:
-    """The folder holding the committed speed/accuracy results (`RESULT_FILES`).
+def results_dir(kind: str = "performance") -> Any:
+    """The folder holding committed results of one kind: ``"performance"`` (the speed/accuracy
+    results, `RESULT_FILES`) or ``"orbits"`` (periodic-orbit branches, census, bifurcation points).
 
-    An installed wheel has them as package data (``jaxcelt/_results/performance``); a checkout
-    (editable install) reads ``docs/performance`` of the repository. Raises ``FileNotFoundError``
+    An installed wheel has them as package data (``jaxcelt/_results/<kind>``); a checkout
+    (editable install) reads ``docs/<kind>`` of the repository. Raises ``FileNotFoundError``
     when neither holds them, rather than letting a notebook show nothing."""
     import pathlib
     from importlib import resources
 
+    marker = {"performance": "reference.json", "orbits": "branches.json"}
+    if kind not in marker:
+        raise ValueError(f"kind must be one of {sorted(marker)}, got {kind!r}")
     candidates = [
-        pathlib.Path(str(resources.files("jaxcelt") / "_results" / "performance")),
-        pathlib.Path(__file__).resolve().parents[1] / "docs" / "performance",
+        pathlib.Path(str(resources.files("jaxcelt") / "_results" / kind)),
+        pathlib.Path(__file__).resolve().parents[1] / "docs" / kind,
     ]
     for c in candidates:
-        if (c / "reference.json").is_file():
+        if (c / marker[kind]).is_file():
             return c
     raise FileNotFoundError(
-        "the committed speed/accuracy results (reference.json, ...) were found in neither "
+        f"the committed {kind} results ({marker[kind]}, ...) were found in neither "
         + " nor ".join(str(c) for c in candidates)
         + '; install jaxcelt from the repository (pip install "jaxcelt @ git+https://github.com/jaxcelt/jaxcelt")'
     )

@@ -226,6 +226,15 @@ def main(argv=None) -> int:
         xlim=tuple(args.window),
     )
     fig.savefig(figdir / "branches_omega2.png", dpi=130)
+    fig = branch_figure(
+        [branches[k] for k in labels],
+        labels=labels,
+        sweep=sw,
+        title="Detail: the period-1 window between the fold and the Neimark-Sacker point",
+        xlim=(14.5, 18.5),
+        ylim=(-1.0, 1.0),
+    )
+    fig.savefig(figdir / "branches_omega2_detail.png", dpi=130)
     fig = multipliers_figure(branches[labels[0]], title=labels[0])
     fig.savefig(figdir / "multipliers.png", dpi=130)
     print(f"wrote {out_json} and {figdir}/*.png")

@@ -32,6 +32,14 @@ def _bench():
     return _json("docs/bifurcation/bench_sweep_400x300.json")
 
 
+def _first_branch() -> dict:
+    return next(iter(_json("docs/orbits/branches.json")["branches"].values()))
+
+
+def _bif(kind: str) -> dict:
+    return next(b for b in _first_branch()["branch"]["bifurcations"] if b["kind"] == kind)
+
+
 def _starts() -> set[str]:
     """Distinct initial conditions over the paper-reproduction study files (same start, one name)."""
     alias = {"rest psi0=0": "rest psi0=0deg", "rest psi0=pi/2": "rest psi0=90deg"}
@@ -164,6 +172,25 @@ QUOTES = [
         ),
     ),
     ("docs/orbits/README.md", lambda: _long14()),
+    # period-1 branches (scripts/orbit_branches.py)
+    ("docs/orbits/README.md", lambda: f"| fold (saddle-node) | {_bif('fold')['value']:.4f} |"),
+    ("docs/orbits/README.md", lambda: f"| Neimark–Sacker | {_bif('Neimark-Sacker')['value']:.4f} |"),
+    (
+        "docs/orbits/README.md",
+        lambda: "| 17 | stable; saddle | {1:.4f}; {0:.4f} |".format(
+            *(r["multipliers_abs"][0] for r in _json("docs/orbits/branches.json")["paper_frequencies"]["17.0"])
+        ),
+    ),
+    (
+        "docs/orbits/README.md",
+        lambda: "the whole branch {:.1f} s".format(_first_branch()["seconds"]["branch_incl_compile"]),
+    ),
+    ("README.md", lambda: f"begins at a fold at {_bif('fold')['value']:.2f} rad/s"),
+    ("docs/orbits/README.md", lambda: f"ω_fold = {_json('docs/orbits/celt_fold_grad.json')['omega_fold']:.6f} rad/s"),
+    (
+        "docs/orbits/README.md",
+        lambda: "relative difference {:.1e}".format(_json("docs/orbits/celt_fold_grad.json")["relative_difference"]).replace("e-0", "e-"),
+    ),
     # paper reproduction (scripts/paper_study.py, scripts/paper_figures.py)
     ("README.md", lambda: f"{len(_starts())} initial conditions"),
     ("docs/paper-reproduction.md", lambda: f"{len(_starts())} starts"),

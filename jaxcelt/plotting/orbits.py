@@ -54,6 +54,7 @@ def branch_figure(
     name: str = "omega_pi",
     title: str = "",
     xlim: tuple[float, float] | None = None,
+    ylim: tuple[float, float] | None = None,
 ):
     """Combined diagram: brute-force section points with continued orbit branches on top.
 
@@ -66,7 +67,7 @@ def branch_figure(
             (``samples``) are drawn underneath in grey (the brute-force diagram).
         component: state component on the vertical axis (`jaxcelt.STATE_NAMES`).
         name: the continued parameter (horizontal axis label).
-        xlim: horizontal range (default: the data's).
+        xlim, ylim: axis ranges (default: the data's).
 
     Returns the matplotlib Figure.
     """
@@ -117,6 +118,8 @@ def branch_figure(
     ax.set_ylabel(_LABELS.get(component, component))
     if xlim is not None:
         ax.set_xlim(*xlim)
+    if ylim is not None:
+        ax.set_ylim(*ylim)
     ax.grid(alpha=0.3)
     ax.set_title(title or "Periodic-orbit branches over the brute-force diagram", fontsize=12)
     return fig
