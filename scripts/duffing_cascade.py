@@ -1,14 +1,16 @@
 """Period-doubling cascade of the forced two-well Duffing oscillator by continuation and branch switching,
 against a brute-force orbit diagram (scipy) -> docs/orbits/duffing_cascade.json and duffing_cascade.png.
 
-x'' + 0.3 x' - x + x^3 = F cos(1.2 t), right-well orbits, F from 0.24. The period-1 branch is
+x'' + 0.3 x' - x + x^3 = F cos(1.2 t), right-well orbits, F from 0.24 to 0.293. The period-1 branch is
 continued in F (`continue_pseudo_arclength`); at each period doubling the period-2k branch is started
 by `switch_at_period_doubling` and continued in turn, up to period 8. Independently, scipy DOP853
-integrates the oscillator over a grid of F (each F started from the previous one's end state,
-400 transient periods, 64 section points) and counts the distinct section points (1e-5). Each doubling
-found by continuation must fall where that count doubles (within one grid step).
+integrates the oscillator over a grid of F (1000 transient periods, 64 section points, all F as one
+vectorised system) and finds each orbit's period (1e-6). At each doubling found by continuation the
+brute-force period must be k ten grid steps below and 2k above, and the brute-force onset of the
+period-2k splitting (|x_{n+k} - x_n|^2 linear in F past a supercritical doubling, extrapolated to
+zero) must agree with the located F_pd.
 
-    python scripts/duffing_cascade.py [--grid 241]
+    python scripts/duffing_cascade.py [--grid 383]
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ from jaxcelt.versions import versions
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 W, D = 1.2, 0.3
 T = 2 * np.pi / W
-F0, F1 = 0.24, 0.29
+F0, F1 = 0.24, 0.293
 
 
 def duffing(t, y, p):
@@ -49,23 +51,36 @@ def _rhs(F):
     return lambda t, y: [y[1], -D * y[1] + y[0] - y[0] ** 3 + F * np.cos(W * t)]
 
 
-def brute_force(Fs, y0, transient=400, sample=64, tol=1e-5):
-    """Distinct section points per F (scipy DOP853, rtol 1e-10), each F from the previous end state."""
-    counts, points, y = [], [], np.asarray(y0, float)
-    for F in Fs:
-        s = solve_ivp(_rhs(F), (0, transient * T), y, method="DOP853", rtol=1e-10, atol=1e-11)
-        y = s.y[:, -1]
-        ts = T * np.arange(transient, transient + sample + 1)
-        s = solve_ivp(_rhs(F), (transient * T, ts[-1]), y, method="DOP853", rtol=1e-10, atol=1e-11, t_eval=ts)
-        sec = s.y.T
-        y = sec[-1]
-        distinct = []
-        for pt in sec:
-            if not any(np.max(np.abs(pt - q)) < tol for q in distinct):
-                distinct.append(pt)
-        counts.append(len(distinct) if len(distinct) <= 16 else 0)  # 0: more than 16 (aperiodic)
-        points.append(sec[:, 0])
-    return np.asarray(counts), np.asarray(points)
+def brute_force(Fs, y0, transient=1000, sample=64, tol=1e-6):
+    """Section points of every F after ``transient`` periods (scipy DOP853, rtol 1e-10, all F as one
+    vectorised system started from ``y0``) and the smallest period p in (1, 2, 4, 8, 16) with
+    max |x_{n+p} - x_n| < tol over the samples (0: none, i.e. aperiodic or not yet converged)."""
+    Fs = np.asarray(Fs, float)
+    n = len(Fs)
+
+    def rhs(t, y):
+        x, v = y[:n], y[n:]
+        return np.concatenate([v, -D * v + x - x**3 + Fs * np.cos(W * t)])
+
+    ts = T * np.arange(transient, transient + sample + 1)
+    y = np.concatenate([np.full(n, y0[0]), np.full(n, y0[1])])
+    s = solve_ivp(rhs, (0.0, ts[-1]), y, method="DOP853", rtol=1e-10, atol=1e-11, t_eval=ts)
+    x = s.y[:n].T  # (samples, n)
+    periods = np.zeros(n, int)
+    for p in (16, 8, 4, 2, 1):
+        ok = np.max(np.abs(x[p:] - x[:-p]), axis=0) < tol
+        periods = np.where(ok, p, periods)
+    return periods, x.T
+
+
+def split_onset(Fs, x, k, lo, hi):
+    """F where the period-2k splitting amplitude of the brute-force orbits vanishes: A = |x_{n+k} - x_n|
+    grows like sqrt(F - F_pd) past a supercritical doubling, so A^2 is fitted linearly in F over the
+    grid points in (lo, hi) and extrapolated to zero."""
+    sel = (Fs > lo) & (Fs < hi)
+    A2 = np.max(np.abs(x[sel, k:] - x[sel, :-k]), axis=1) ** 2
+    c1, c0 = np.polyfit(Fs[sel], A2, 1)
+    return float(-c0 / c1), int(sel.sum())
 
 
 def cascade(levels=3):
@@ -98,28 +113,39 @@ def cascade(levels=3):
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--grid", type=int, default=241, help="brute-force values of F in [0.24, 0.29]")
+    ap.add_argument("--grid", type=int, default=383, help="brute-force values of F in [0.255, 0.2932]")
     ap.add_argument("--out", type=pathlib.Path, default=ROOT / "docs/orbits")
     a = ap.parse_args(argv)
     t = time.perf_counter()
     pds, branches = cascade()
     t_cont = time.perf_counter() - t
-    Fs = np.linspace(F0, F1, a.grid)
+    Fs = np.linspace(0.255, 0.2932, a.grid)
     t = time.perf_counter()
-    counts, points = brute_force(Fs, [1.0, 0.0])
+    periods, points = brute_force(Fs, [1.0, 0.0])
     t_brute = time.perf_counter() - t
     h = Fs[1] - Fs[0]
-    for r in pds:
-        below = counts[(Fs < r["F_pd"] - h) & (Fs > r["F_pd"] - 2 * h)]
-        above = counts[(Fs > r["F_pd"] + h) & (Fs < r["F_pd"] + 2 * h)]
-        r["brute_force_count_below"] = int(below[0]) if len(below) else None
-        r["brute_force_count_above"] = int(above[0]) if len(above) else None
-        # first grid value at which the brute-force count exceeds k (the doubling seen by brute force)
-        first = Fs[np.argmax((counts > r["k"]) | (counts == 0))]
-        r["brute_force_first_F_above_k"] = float(first)
-        r["agrees_within_grid_step"] = bool(abs(first - r["F_pd"]) <= h)
+    for i, r in enumerate(pds):
+        k, F = r["k"], r["F_pd"]
+        # ten grid steps from the doubling (slow convergence next to it), fewer where the period-2k
+        # window is narrow (its width estimated with Feigenbaum's 4.669 from the previous doubling)
+        gap = (F - pds[i - 1]["F_pd"]) / 4.669 if i else 1.0
+        d = max(2, min(10, int(gap / 3 / h))) * h
+        r["brute_force_distance"] = float(d)
+        below = periods[(Fs < F - d)][-3:]
+        above = periods[(Fs > F + d)][:3]
+        r["brute_force_periods_below"] = below.tolist()
+        r["brute_force_periods_above"] = above.tolist()
+        r["period_k_below_2k_above"] = bool(len(below) and len(above) and np.all(below == k) and np.all(above == 2 * k))
+        nxt = pds[i + 1]["F_pd"] if i + 1 < len(pds) else Fs[-1]
+        # the splitting fit over the first third of the period-2k window, skipping ten grid steps (slow convergence at the doubling)
+        lo, hi = F + 10 * h, F + (nxt - F) / 3
+        if hi - lo > 4 * h:
+            onset, m = split_onset(Fs, points, k, lo, hi)
+            r["brute_force_onset"] = onset
+            r["brute_force_onset_points"] = m
+            r["onset_difference"] = abs(onset - F)
     res = {
-        "system": "x'' + 0.3 x' - x + x^3 = F cos(1.2 t), right well, F in [0.24, 0.29]",
+        "system": "x'' + 0.3 x' - x + x^3 = F cos(1.2 t), right well, continuation from F = 0.24 to 0.293",
         "period_doublings": pds,
         "ratios": [
             (pds[i]["F_pd"] - pds[i - 1]["F_pd"]) / (pds[i + 1]["F_pd"] - pds[i]["F_pd"])
@@ -144,8 +170,11 @@ def main(argv=None) -> int:
     ax.plot([], [], ".", color="0.5", label="scipy brute force (section points)")
     for b, c in zip(branches, ("tab:blue", "tab:orange", "tab:green", "tab:red"), strict=False):
         F, x, st = np.asarray(b["F"]), np.asarray(b["x"]), np.asarray(b["stable"])
-        ax.plot(np.where(st, F, np.nan), np.where(st, x, np.nan), "-", color=c, lw=1.6, label=f"period-{b['k']} branch")
-        ax.plot(np.where(~st, F, np.nan), np.where(~st, x, np.nan), "--", color=c, lw=1.0)
+        cut = np.flatnonzero(np.diff(st.astype(int))) + 1  # runs of equal stability, sharing end points
+        for a0, a1 in zip(np.r_[0, cut], np.r_[cut, len(F) - 1], strict=True):
+            seg = slice(a0, max(a1, a0 + 1) + 1)
+            ax.plot(F[seg], x[seg], "-" if st[a0] else "--", color=c, lw=1.6 if st[a0] else 1.0)
+        ax.plot([], [], "-", color=c, lw=1.6, label=f"period-{b['k']} branch (one section point)")
     for r in pds:
         ax.axvline(r["F_pd"], color="tab:red", lw=0.7, ls=":")
         ax.annotate(f"PD {r['F_pd']:.5f}", (r["F_pd"], ax.get_ylim()[1]), xytext=(2, -12), textcoords="offset points",

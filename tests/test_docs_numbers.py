@@ -172,6 +172,15 @@ QUOTES = [
         ),
     ),
     ("docs/orbits/README.md", lambda: _long14()),
+    # Duffing cascade (scripts/duffing_cascade.py)
+    (
+        "docs/orbits/README.md",
+        lambda: "| 2 → 4 | {:.7f} |".format(_json("docs/orbits/duffing_cascade.json")["period_doublings"][1]["F_pd"]),
+    ),
+    (
+        "docs/orbits/README.md",
+        lambda: "intervals is {:.2f}".format(_json("docs/orbits/duffing_cascade.json")["ratios"][0]),
+    ),
     # period-1 branches (scripts/orbit_branches.py)
     ("docs/orbits/README.md", lambda: f"| fold (saddle-node) | {_bif('fold')['value']:.4f} |"),
     ("docs/orbits/README.md", lambda: f"| Neimark–Sacker | {_bif('Neimark-Sacker')['value']:.4f} |"),

@@ -63,3 +63,35 @@ def test_period_doubling_located_and_switched_matches_brute_force():
     assert np.max(np.abs(brute[2:] - brute[:-2])) < 1e-6
     assert min(np.abs(brute[-1] - orb.y).max(), np.abs(brute[-2] - orb.y).max()) < 1e-6
     assert abs(np.prod(orb.multipliers).real - np.exp(-D * 2 * T)) < 1e-7
+
+
+@pytest.mark.slow  # ~90 s: three branches and a 383-value scipy orbit diagram
+def test_duffing_cascade_by_continuation_matches_brute_force_orbit_diagram():
+    # scripts/duffing_cascade.py: period 1 -> 2 -> 4 -> 8 by continuation and branch switching. The
+    # scipy orbit diagram (no JAX, no Newton) has period k just below each located doubling and 2k
+    # just above; where the period-2k window is wide enough, the brute-force onset of the splitting
+    # (|x_{n+k} - x_n|^2 linear in F, extrapolated) agrees with the located doubling within one
+    # grid step (1e-4); the PD multipliers are -1 to 1e-8 (bisection in F to ~1e-10).
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "scripts" / "duffing_cascade.py"
+    spec = importlib.util.spec_from_file_location("duffing_cascade", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    pds, _ = mod.cascade()
+    assert [r["k"] for r in pds] == [1, 2, 4]
+    assert all(r["multiplier_nearest_minus_one"] < 1e-8 for r in pds)
+    Fs = np.linspace(0.255, 0.2932, 383)
+    h = Fs[1] - Fs[0]
+    periods, points = mod.brute_force(Fs, [1.0, 0.0])
+    prev = None
+    for r in pds:
+        k, F = r["k"], r["F_pd"]
+        d = (max(2, min(10, int((F - prev) / 4.669 / 3 / h))) if prev else 10) * h
+        assert np.all(periods[Fs < F - d][-3:] == k) and np.all(periods[Fs > F + d][:3] == 2 * k), (k, F)
+        prev = F
+    onset, _ = mod.split_onset(
+        Fs, points, 1, pds[0]["F_pd"] + 10 * h, pds[0]["F_pd"] + (pds[1]["F_pd"] - pds[0]["F_pd"]) / 3
+    )
+    assert abs(onset - pds[0]["F_pd"]) < h
