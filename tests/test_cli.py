@@ -4,12 +4,15 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from jaxcelt.cli import main
 from jaxcelt.io import load_trajectory
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_simulate_writes_data_and_figure(tmp_path):
@@ -234,3 +237,19 @@ def test_bifurcation_summary_caps_the_range_list(tmp_path):
     ds = _fake_sweep()
     text = format_summary(ds, wall_seconds=1.0, out=tmp_path, files=[], max_ranges=2)
     assert len(_printed_ranges(text)) == 2 and "1 more ranges" in text
+
+
+@pytest.mark.slow  # ~2 min: a transient, one Newton solve and a short branch, with compilation
+def test_orbits_command_writes_orbit_branch_and_figures(tmp_path, monkeypatch):
+    monkeypatch.setenv("JAXCELT_CACHE_DIR", "off")
+    out = tmp_path / "orbits"
+    code = main(["orbits", "--omega-pi", "15.6", "--continue", "15.5:15.7", "--max-points", "5", "--out", str(out)])
+    assert code == 0
+    r = json.loads((out / "orbits.json").read_text())
+    assert r["orbit"]["status"] == "converged" and r["orbit"]["stable"]
+    # the orbit reached from rest at psi0 = 157.5 deg is the one of docs/orbits/orbit_check.json
+    ref = json.loads((ROOT / "docs/orbits/orbit_check.json").read_text())
+    np.testing.assert_allclose(r["orbit"]["multipliers_abs"], ref["multipliers_abs"], atol=1e-6)
+    vals = r["branch"]["values"]
+    assert len(vals) == 5 and min(vals) < 15.6 < max(vals) and vals[r["branch"]["start"]] == 15.6
+    assert (out / "branch.png").stat().st_size > 0 and (out / "multipliers.png").stat().st_size > 0

@@ -195,6 +195,12 @@ QUOTES = [
         lambda: "the whole branch {:.1f} s".format(_first_branch()["seconds"]["branch_incl_compile"]),
     ),
     ("README.md", lambda: f"begins at a fold at {_bif('fold')['value']:.2f} rad/s"),
+    (
+        "docs/orbits/README.md",
+        lambda: "diagram {:.1f} s with compilation".format(
+            _json("docs/orbits/branches.json")["brute_force"]["seconds_incl_compile"]
+        ),
+    ),
     ("docs/orbits/README.md", lambda: f"ω_fold = {_json('docs/orbits/celt_fold_grad.json')['omega_fold']:.6f} rad/s"),
     (
         "docs/orbits/README.md",
