@@ -1,13 +1,16 @@
 """Measured trajectories for identification: observation models, a synthetic-data generator and
 a documented, pickle-free file format.
 
-Observation models (`observe`), each a function of the state y (13,) and the parameters:
+Observation models (`observe`), each a function of the state y (13,), the parameters and (for
+"accel") the time:
 
 ===============  =====  ==================================================================
 ``"state"``      13     the full state (v, omega, n, r_C, psi), MODEL.md section 8
 ``"omega"``       3     body angular velocity [rad/s] -- what a strapped-on IMU gyro measures
 ``"orientation"`` 4     (n1, n2, n3, psi): vertical in body axes and precession angle [-, rad]
 ``"centre"``      3     global position of the geometric centre O [m] (motion capture)
+``"accel"``       3     specific force at the mass centre in body axes [m/s^2] -- what an IMU
+                        accelerometer at C measures (`specific_force`; depends on t)
 ===============  =====  ==================================================================
 
 File format (``.npz``, written by `save_data`, read by `load_data` with ``allow_pickle=False``).
@@ -43,8 +46,9 @@ import jax.numpy as jnp
 import numpy as np
 
 from . import _config  # noqa: F401
-from ._types import Array, State
+from ._types import Array, ArrayLike, State
 from .diagnostics import centre_position
+from .model import vector_field
 from .params import CeltParams
 
 __all__ = [
@@ -52,6 +56,7 @@ __all__ = [
     "Trajectory",
     "MeasuredData",
     "observe",
+    "specific_force",
     "generate_data",
     "save_data",
     "load_data",
@@ -64,12 +69,25 @@ __all__ = [
 FORMAT = "jaxcelt-measured-data"
 FORMAT_VERSION = 1
 
-OBSERVABLES: dict[str, int] = {"state": 13, "omega": 3, "orientation": 4, "centre": 3}
-"""Observation kind -> number of channels."""
+OBSERVABLES: dict[str, int] = {"state": 13, "omega": 3, "orientation": 4, "centre": 3, "accel": 3}
+"""Observation kind -> number of channels: the state; omega (a gyro in body axes) [rad/s];
+orientation (n, psi); centre (the geometric centre O, global) [m]; accel (an accelerometer at the
+mass centre C in body axes: the specific force a - g, what an IMU measures) [m/s^2]."""
 
 
-def observe(y: State, params: CeltParams, kind: str) -> Array:
-    """Observation ``kind`` (see `OBSERVABLES`) of one state y (13,); vmap for a time series."""
+def specific_force(t: ArrayLike, y: State, params: CeltParams) -> Array:
+    """Specific force at the mass centre in body axes [m/s^2]: acceleration minus gravity.
+
+    With the body-frame derivative of v (MODEL.md section 8), a = v_dot + omega x v and gravity
+    is -g n, so f = v_dot + omega x v + g n (= N (n + t) / m, the contact force per unit mass;
+    g n at rest on a still base). It depends on t through the base motion."""
+    v_dot = vector_field(t, y, params)[0:3]
+    return v_dot + jnp.cross(y[3:6], y[0:3]) + params.g * y[6:9]
+
+
+def observe(y: State, params: CeltParams, kind: str, t: ArrayLike = 0.0) -> Array:
+    """Observation ``kind`` (see `OBSERVABLES`) of one state y (13,) at time t; vmap for a time
+    series (only "accel" depends on t, through the base's motion)."""
     if kind == "state":
         return y
     if kind == "omega":
@@ -78,6 +96,8 @@ def observe(y: State, params: CeltParams, kind: str) -> Array:
         return jnp.concatenate([y[6:9], y[12:13]])
     if kind == "centre":
         return centre_position(y, params)
+    if kind == "accel":
+        return specific_force(t, y, params)
     raise ValueError(f"unknown observation kind {kind!r}; known: {sorted(OBSERVABLES)}")
 
 
@@ -198,7 +218,7 @@ def generate_data(
             raise ValueError(f"generate_data: trajectory {i} failed or left the model's validity: {sol.summary()}")
         obs, sig = {}, {}
         for k in kinds:
-            clean = np.asarray(jax.vmap(lambda y, k=k, p=p: observe(y, p, k))(sol.ys))
+            clean = np.asarray(jax.vmap(lambda y, t, k=k, p=p: observe(y, p, k, t))(sol.ys, sol.ts))
             rms = np.sqrt(np.mean(clean**2, axis=0))
             rms = np.maximum(rms, 1e-6 * rms.max())
             sigma = (noise if noise > 0 else 0.01) * rms
@@ -309,10 +329,11 @@ CSV_COLUMNS: dict[str, tuple[str, ...]] = {
     "omega": ("omega1", "omega2", "omega3"),
     "orientation": ("n1", "n2", "n3", "psi"),
     "centre": ("x_O", "y_O", "z_O"),
+    "accel": ("f1", "f2", "f3"),
     "state": tuple(f"y{i}" for i in range(13)),
 }
 """CSV column names per observation kind (units: omega [rad/s] in body axes, n [-], psi [rad],
-centre [m], state as MODEL.md section 8)."""
+centre [m], accel [m/s^2] in body axes, state as MODEL.md section 8)."""
 
 
 def from_arrays(

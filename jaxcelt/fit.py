@@ -252,7 +252,7 @@ class _Problem(eqx.Module):
             ys, _ = self._simulate_record(pr, zs, fixed, ts)
             mis, pen = [], []
             for kind in kinds:
-                h = jax.vmap(jax.vmap(lambda y, kind=kind: observe(y, pr, kind)))(ys)
+                h = jax.vmap(jax.vmap(lambda y, t, kind=kind: observe(y, pr, kind, t)))(ys, ts)
                 r = (h - obs[kind]) * inv_sigma[kind][None, None, :] * wts[kind] * mask[kind][..., None]
                 # window k>0 starts at the previous window's last sample: count it once
                 mis.append(jnp.concatenate([r[0].reshape(-1), r[1:, 1:].reshape(-1)]))
@@ -880,7 +880,7 @@ def predict(result: FitResult) -> list[dict[str, Any]]:
         p = eqx.tree_at(lambda q: (q.omega_pi, q.q_pi), p, (rec.omega_pi[i], rec.q_pi[i]))
         d = {"ts": np.asarray(rec.ts[i]), "ys": np.asarray(ys)}
         for kind in OBSERVABLES:
-            d[kind] = np.asarray(jax.vmap(jax.vmap(lambda y, kind=kind, p=p: observe(y, p, kind)))(ys))
+            d[kind] = np.asarray(jax.vmap(jax.vmap(lambda y, t, kind=kind, p=p: observe(y, p, kind, t)))(ys, rec.ts[i]))
         d["data"] = {k: np.asarray(v[i]) for k, v in rec.obs.items()}
         d["mask"] = {k: np.asarray(v[i]) > 0 for k, v in rec.mask.items()}
         out.append(d)

@@ -3,6 +3,7 @@
 import dataclasses
 
 import jax
+import jax.numpy as jnp
 import numpy as np
 import pytest
 
@@ -132,3 +133,43 @@ def test_from_arrays_and_csv_errors(tmp_path):
     with pytest.raises(ValueError, match="omega_pi"):
         load_csv(nofreq)
     assert load_csv(nofreq, omega_pi=17.0, q_pi=0.04).obs["omega"].shape == (2, 3)
+
+
+def test_accelerometer_is_the_specific_force_of_the_trajectory():
+    # independent of the vector field's algebra: central differences (h = 1e-6 s) of the global
+    # velocity of C along a tight simulate (rtol 1e-12), plus g E3, rotated into body axes
+    # (R rows E1, E2, n; MODEL.md section 4). The smoothed friction (eps = 1e-4 m/s) changes on
+    # ~1e-4 s, so the jerk reaches ~1e4 m/s^3 (h = 1e-4 s gave 1e-4 errors): truncation
+    # h^2 |v'''| / 6 ~ 2e-9, integration noise ~1e-13 / h ~ 1e-7: 1e-5 m/s^2 (1e-6 of g).
+    from jaxcelt.model import horizontal_frame
+
+    p = jc.CeltParams.paper(omega_pi=15.6)
+    y0 = jc.initial_state(p, psi=np.radians(157.5))
+    h = 1e-6
+    centres = np.array([2.0, 2.37, 3.1])
+    ts = np.sort(np.r_[centres - h, centres, centres + h])
+    sol = jc.simulate(p, y0, float(ts[-1]), ts=jnp.asarray(ts), rtol=1e-12, atol=1e-14, exact_ts=True)
+    ys = np.asarray(sol.ys)
+
+    def v_global(y):
+        fr = horizontal_frame(jnp.asarray(y[6:9]), y[12])
+        return np.array([np.dot(fr.E1, y[0:3]), np.dot(fr.E2, y[0:3]), np.dot(y[6:9], y[0:3])])
+
+    for i in range(len(centres)):
+        ym, yc, yp = ys[3 * i : 3 * i + 3]
+        a = (v_global(yp) - v_global(ym)) / (2 * h)
+        f_glob = a + np.array([0.0, 0.0, float(p.g)])
+        fr = horizontal_frame(jnp.asarray(yc[6:9]), yc[12])
+        f_body = np.asarray(fr.E1) * f_glob[0] + np.asarray(fr.E2) * f_glob[1] + yc[6:9] * f_glob[2]
+        got = np.asarray(observe(jnp.asarray(yc), p, "accel", centres[i]))
+        assert np.linalg.norm(got) > 1.0  # a moving stone, not a trivial check
+        np.testing.assert_allclose(got, f_body, atol=1e-5)
+
+
+def test_accelerometer_at_rest_reads_g_along_the_vertical():
+    # the stone at rest in its equilibrium on a still base: no acceleration, the accelerometer
+    # reads +g along the vertical (and the gyro 0); turned by psi it reads the same in body axes
+    p = jc.CeltParams.paper(q_pi=0.0)
+    for psi in (0.0, 1.3):
+        y = jnp.asarray(jc.initial_state(p, psi=psi))
+        np.testing.assert_allclose(np.asarray(observe(y, p, "accel")), [0.0, 0.0, float(p.g)], atol=1e-12)
