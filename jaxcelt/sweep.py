@@ -88,13 +88,12 @@ from typing import Any
 
 import diffrax
 import equinox as eqx
-import equinox.internal as eqxi
 import jax
 import jax.numpy as jnp
 import numpy as np
-from diffrax._term import WrapTerm  # what diffeqsolve wraps terms in (not re-exported)
 
 from . import _config  # noqa: F401
+from ._diffrax_adapter import clip_to_end, loop_init, loop_step, t1_clip_floor, wrap_term
 from ._types import Array
 from .contact import AbstractContactLaw, get_contact_law
 from .diagnostics import centre_position
@@ -256,10 +255,8 @@ def _extras(ys: Array, p: CeltParams) -> dict[str, Array]:
 def _pool_parts(cfg: SweepConfig):
     law = get_contact_law(cfg.contact_law)
     solver = MonitoredSolver(solver=_fill_implicit_tols(cfg.solver, cfg.rtol, cfg.atol), law=law)
-    # diffeqsolve wraps every term in WrapTerm(term, direction); with it, PIDController.init
-    # takes diffrax's fixed first trial step (0.01) instead of the ODETerm-only heuristic --
-    # mirrored here so that lanes equal `simulate` step for step
-    term = WrapTerm(diffrax.ODETerm(_Field(law)), jnp.asarray(1))
+    # wrapped as diffeqsolve wraps it, so that lanes equal `simulate` step for step
+    term = wrap_term(diffrax.ODETerm(_Field(law)))
     return law, solver, term
 
 
@@ -287,11 +284,9 @@ def _lane_init(cfg: SweepConfig, p: CeltParams, y0: Array, ts: Array, tols: Arra
     law, solver, term = _pool_parts(cfg)
     t0 = jnp.asarray(cfg.t0, jnp.float64)
     t1 = ts[-1]
-    ctrl = _controller(tols, ts)
-    tnext, cstate = ctrl.init(term, t0, t1, y0, None, p, solver.func, solver.error_order(term))
-    tnext = jnp.minimum(tnext, t1)
-    if _erk_tableau(cfg) is None:
-        sstate = solver.init(term, t0, tnext, y0, p)
+    fused = _erk_tableau(cfg) is not None
+    tnext, cstate, sstate = loop_init(solver, term, _controller(tols, ts), t0, t1, y0, p, solver_state=not fused)
+    if not fused:
         state = dict(sstate=sstate, cstate=cstate)
     else:
         # the fused step's state: the FSAL derivative and the monitor, from one evaluation
@@ -304,9 +299,7 @@ def _lane_init(cfg: SweepConfig, p: CeltParams, y0: Array, ts: Array, tols: Arra
             min_N=N,
             min_n3=y0[8],
         )
-    floor = t1
-    for _ in range(100):  # diffrax's t1_clip_floor: t1 - 100 ULP
-        floor = eqxi.prevbefore(floor)
+    floor = t1_clip_floor(t1)
     k0 = (ts[0] <= t0).astype(jnp.int32)  # a section time at t0 is the initial state itself
     stop0 = jnp.asarray(cfg.stop_on_invalid) & (_lane_monitor(state)[1] > 0)
     return dict(
@@ -413,8 +406,7 @@ def _erk_lane_step(
     hit = keep & (st["k"] < S) & (ts[jnp.minimum(st["k"], S - 1)] <= tprev)
     k = st["k"] + hit.astype(jnp.int32)
     tnext = jnp.where(k < S, jnp.minimum(ts[jnp.minimum(k, S - 1)], tnext), tnext)  # diffrax's _clip_t
-    tprev = jnp.minimum(tprev, t1)
-    tnext = jnp.where(tnext > st["floor"], jnp.where(keep, t1, tprev + 0.5 * (t1 - tprev)), tnext)
+    tprev, tnext = clip_to_end(tprev, tnext, t1, st["floor"], keep)
     # validity monitor at the accepted step's end (N, den from the FSAL evaluation)
     N, den = aux
     kind = invalid_kind(N, den, y1[8])
@@ -450,13 +442,10 @@ def _lane_step(cfg: SweepConfig, st: dict[str, Any]) -> tuple[dict[str, Any], Ar
     R = diffrax.RESULTS
     _, solver, term = _pool_parts(cfg)
     p, ts, t1 = st["p"], st["ts"], st["t1"]
-    y1, y_err, _, sstate, sres = solver.step(term, st["tprev"], st["tnext"], st["y"], p, st["sstate"], False)
-    y_err = jnp.where(jnp.isnan(y_err), jnp.inf, y_err)
-    keep, tprev, tnext, _, cstate, cres = _controller(st["tols"], ts).adapt_step_size(
-        st["tprev"], st["tnext"], st["y"], y1, p, y_err, solver.error_order(term), st["cstate"]
-    )
-    tprev = jnp.minimum(tprev, t1)
-    tnext = jnp.where(tnext > st["floor"], jnp.where(keep, t1, tprev + 0.5 * (t1 - tprev)), tnext)
+    keep, y1, tprev, tnext, sstate, cstate, sres, cres = loop_step(
+        solver, term, _controller(st["tols"], ts), t1, st["floor"], st["tprev"], st["tnext"], st["y"], p,
+        st["sstate"], st["cstate"],
+    )  # fmt: skip
     y = jnp.where(keep, y1, st["y"])
     sstate = jax.tree_util.tree_map(lambda a, b: jnp.where(keep, a, b), sstate, st["sstate"])
     sres = R.where(keep, sres, R.successful)
