@@ -11,14 +11,14 @@ Execution model
 ---------------
 * Lanes are processed in chunks of ``chunk_size`` (the unit of resumable writing). A chunk
   runs as **one** jitted while loop over ``width``
-  batch slots (`_pool`): each iteration makes one step in every slot, and a slot whose lane
+  batch slots (`jaxcelt.ensemble.run_pool`): each iteration makes one step in every slot, and a slot whose lane
   finished is refilled with the next lane at once. Step slots are therefore only wasted in
   the final drain, not for every lane until the slowest one is done. The step is the
   algorithm of diffrax's loop body (PID + ClipStepSizeController, the same first-step
   choice, the validity monitor): for explicit FSAL Runge-Kutta solvers (Tsit5, the default;
-  Dopri5, Dopri8, ...) written out as one fused step (`_erk_lane_step`: the monitor reads N
+  Dopri5, Dopri8, ...) written out as one fused step (`jaxcelt.ensemble.FusedERKStepper`: the monitor reads N
   from the step's last evaluation, stage inputs are materialised once, lane-constant
-  parameters stay out of the slots), otherwise diffrax's own step (`_lane_step`). A Tsit5
+  parameters stay out of the slots), otherwise diffrax's own step (`jaxcelt.ensemble.DiffraxStepper`). A Tsit5
   lane equals `jaxcelt.simulate` to rounding with the same step count (tests); with
   Dopri8, whose error weights cancel strongly, rounding moves the step-size sequence
   slightly (a few steps in ~400, samples ~1e-9 apart at rtol 1e-7). Lane order (and hence
@@ -93,14 +93,28 @@ import jax.numpy as jnp
 import numpy as np
 
 from . import _config  # noqa: F401
-from ._diffrax_adapter import clip_to_end, loop_init, loop_step, t1_clip_floor, wrap_term
 from ._types import Array
 from .contact import AbstractContactLaw, get_contact_law
 from .diagnostics import centre_position
+from .ensemble import (
+    DEFAULT_WIDTH,
+    MIN_DRAIN_WIDTH,  # noqa: F401  (re-exported: jaxcelt.sweep.MIN_DRAIN_WIDTH)
+    PILOT_FRACTION,
+    AbstractLaneStepper,
+    PoolStats,
+    device_mesh,
+    erk_tableau,
+    lane_outputs,
+    make_stepper,
+    pad_lanes,
+    run_pool,
+    shard_lanes,
+    split_lane_args,
+    start_lanes,
+)
 from .lyapunov import celt_lyapunov
-from .model import vector_field_and_normal
 from .params import PARAM_NAMES, CeltParams
-from .solve import DEFAULT_SOLVER, MonitoredSolver, _Field, _fill_implicit_tols, invalid_kind, simulate, status_code
+from .solve import DEFAULT_SOLVER, simulate
 from .state import initial_state
 
 __all__ = [
@@ -113,6 +127,7 @@ __all__ = [
     "parse_range",
     "orbit",
     "run_lanes",
+    "run_lanes_with_stats",
     "parameter_map",
 ]
 
@@ -247,258 +262,22 @@ def _extras(ys: Array, p: CeltParams) -> dict[str, Array]:
 
 
 # --------------------------------------------------------------------------------------
-# Lane pool: one jitted while loop over a fixed number of batch slots that are refilled
-# with the next lane as soon as a lane finishes (no slot waits for the chunk's slowest lane).
+# Stroboscopic lanes on the lane engine (`jaxcelt.ensemble`): section times, the jitted
+# chunk (pool, per-lane outputs, global motion), sharding over devices, the Lyapunov stage.
 # --------------------------------------------------------------------------------------
 
 
-def _pool_parts(cfg: SweepConfig):
-    law = get_contact_law(cfg.contact_law)
-    solver = MonitoredSolver(solver=_fill_implicit_tols(cfg.solver, cfg.rtol, cfg.atol), law=law)
-    # wrapped as diffeqsolve wraps it, so that lanes equal `simulate` step for step
-    term = wrap_term(diffrax.ODETerm(_Field(law)))
-    return law, solver, term
-
-
-def _controller(tols: Array, ts: Array):
-    # the same controller `simulate(..., exact_ts=True)` builds; the tolerances are traced
-    # there too (jit arguments): as constants XLA would fold them differently (1-ulp changes
-    # of the error norm flip accept/reject decisions and the lane would not equal `simulate`)
-    pid = diffrax.PIDController(rtol=tols[0], atol=tols[1])
-    return diffrax.ClipStepSizeController(pid, step_ts=ts)
-
-
 def _erk_tableau(cfg: SweepConfig) -> Any:
-    """Butcher tableau of an explicit FSAL Runge-Kutta solver (Tsit5, Dopri5, Dopri8, ...) or None.
-
-    For these the pool runs its own fused step (`_erk_lane_step`); any other solver (implicit,
-    non-FSAL) runs diffrax's own step (`_lane_step`)."""
-    tab = getattr(cfg.solver, "tableau", None)
-    if isinstance(cfg.solver, diffrax.AbstractERK) and tab is not None and tab.fsal and tab.b_error is not None:
-        return tab
-    return None
+    """`jaxcelt.ensemble.erk_tableau` of the sweep's solver: the fused step's tableau, or None
+    (diffrax's own step)."""
+    return erk_tableau(cfg.solver)
 
 
-def _lane_init(cfg: SweepConfig, p: CeltParams, y0: Array, ts: Array, tols: Array) -> dict[str, Any]:
-    """diffeqsolve's initialisation (controller.init picks the first step, solver.init)."""
-    law, solver, term = _pool_parts(cfg)
-    t0 = jnp.asarray(cfg.t0, jnp.float64)
-    t1 = ts[-1]
-    fused = _erk_tableau(cfg) is not None
-    tnext, cstate, sstate = loop_init(solver, term, _controller(tols, ts), t0, t1, y0, p, solver_state=not fused)
-    if not fused:
-        state = dict(sstate=sstate, cstate=cstate)
-    else:
-        # the fused step's state: the FSAL derivative and the monitor, from one evaluation
-        f0, (N, den) = vector_field_and_normal(t0, y0, p, law)
-        kind = invalid_kind(N, den, y0[8])
-        state = dict(
-            f=f0,
-            first_invalid_t=jnp.where(kind > 0, t0, jnp.inf),
-            first_invalid_kind=kind,
-            min_N=N,
-            min_n3=y0[8],
-        )
-    floor = t1_clip_floor(t1)
-    k0 = (ts[0] <= t0).astype(jnp.int32)  # a section time at t0 is the initial state itself
-    stop0 = jnp.asarray(cfg.stop_on_invalid) & (_lane_monitor(state)[1] > 0)
-    return dict(
-        p=p,
-        ts=ts,
-        tols=tols,
-        t1=t1,
-        floor=floor,
-        y=y0,
-        tprev=t0,
-        tnext=tnext,
-        result=diffrax.RESULTS.where(stop0, diffrax.RESULTS.event_occurred, diffrax.RESULTS.successful),
-        num_steps=jnp.zeros((), jnp.int32),
-        k=k0,
-        done=stop0,
-        **state,
-    )
-
-
-def _lane_monitor(st: dict[str, Any]) -> tuple[Array, Array, Array, Array]:
-    """(first_invalid_t, first_invalid_kind, min_N, max_tilt) of a slot, either step kernel."""
-    if "sstate" in st:
-        mon = st["sstate"][1]
-        return mon.first_invalid_t, mon.first_invalid_kind, mon.min_N, mon.max_tilt
-    # max over steps of arccos(n3) = arccos(min n3): arccos is decreasing
-    return st["first_invalid_t"], st["first_invalid_kind"], st["min_N"], jnp.arccos(jnp.clip(st["min_n3"], -1, 1))
-
-
-def _combine(y0: Array, coeffs: Any, ks: list[Array]) -> Array:
-    """y0 + sum_j coeffs[j] ks[j] over the non-zero coefficients (tableau constants)."""
-    out = y0
-    for a, k in zip(np.asarray(coeffs, dtype=float), ks):
-        if a != 0.0:
-            out = out + a * k
-    return out
-
-
-def _kernel_boundary(opaque_true: Array) -> Callable[[Array], Array]:
-    """x -> x, materialised: a conditional on a predicate XLA cannot see (a runtime True).
-
-    XLA's CPU fusion copies cheap producers into every consumer kernel, so without this each
-    of the right-hand side's ~40 kernels recomputes the stage input y0 + sum_j a_ij k_j for
-    the components it reads; a conditional is a kernel boundary, after which they read one
-    buffer instead (measured: a Tsit5 lane-step 3.0 -> 2.1 us on one core, 32 lanes). The
-    other branch is never taken; it returns NaN so that it could not pass unnoticed, and it
-    differs from the first so that XLA does not fold the conditional away.
-    """
-
-    def boundary(x: Array) -> Array:
-        return jax.lax.cond(opaque_true, lambda x: x, lambda x: jnp.full_like(x, jnp.nan), x)
-
-    return boundary
-
-
-def _erk_lane_step(
-    cfg: SweepConfig, tab: Any, st: dict[str, Any], boundary: Callable[[Array], Array] = lambda x: x
-) -> tuple[dict[str, Any], Array]:
-    """`_lane_step` for an explicit FSAL Runge-Kutta tableau, fused into one straight-line step.
-
-    The same algorithm as diffrax's loop body with ``PIDController`` (I-control, diffrax's
-    defaults) inside ``ClipStepSizeController(step_ts=ts)``: stages k_i = dt f(t0 + c_i dt,
-    y0 + sum_j a_ij k_j), y1 = y0 + sum b_i k_i, error sum e_i k_i, the RMS error ratio and
-    factor clip(0.9 err^(-1/q), [1, 10] if accepted else [0.2, 0.9]) with q the error order
-    diffrax gives its controller (Tsit5 5, Dopri8 8), the next step
-    clipped onto the next section time and onto t1. The last stage is f(t1, y1) (FSAL); its
-    normal force and denominator feed the validity monitor, so monitoring costs no extra
-    evaluation (diffrax's `MonitoredSolver` evaluates N once more per step). Without diffrax's
-    generic stage loop, stage buffer and dense-output bookkeeping, XLA fuses the step into
-    fewer kernels (``benchmarks/bench_step_parts.py``). Tsit5 lanes agree with `simulate` to
-    rounding (the arithmetic order differs), with the same step counts (tests); Dopri8's
-    strongly cancelling error weights let rounding move a few steps (module docstring).
-    ``boundary``: applied to every stage input (`_kernel_boundary`; identity by default).
-    """
-    R = diffrax.RESULTS
-    law = get_contact_law(cfg.contact_law)
-    p, ts, t1, y0, t0 = st["p"], st["ts"], st["t1"], st["y"], st["tprev"]
-    dt = st["tnext"] - t0
-    ks = [st["f"] * dt]
-    for c, a in zip(np.asarray(tab.c, dtype=float), tab.a_lower):
-        yi = boundary(_combine(y0, a, ks))
-        fi, aux = vector_field_and_normal(t0 + c * dt, yi, p, law)
-        ks.append(fi * dt)
-    b = np.asarray(tab.b_sol, dtype=float)
-    fsal_is_y1 = b[-1] == 0.0 and np.array_equal(np.asarray(tab.a_lower[-1], dtype=float), b[:-1])
-    y1 = yi if fsal_is_y1 else _combine(y0, b, ks)
-    y_err = _combine(jnp.zeros_like(y0), tab.b_error, ks)
-    y_err = jnp.where(jnp.isnan(y_err), jnp.inf, y_err)
-    # diffrax PIDController.adapt_step_size (pcoeff = dcoeff = 0, icoeff = 1)
-    pid = diffrax.PIDController(rtol=st["tols"][0], atol=st["tols"][1])
-    y1s = jnp.where(jnp.isnan(y1).any(), y0, y1)
-    scaled = pid.norm(y_err / (pid.atol + jnp.maximum(jnp.abs(y0), jnp.abs(y1s)) * pid.rtol))
-    keep = scaled < 1
-    inv = 1 / scaled
-    order = cfg.solver.error_order(_pool_parts(cfg)[2])  # exactly what diffrax's controller is given
-    factor = jnp.clip(
-        pid.safety * inv ** (1.0 / order),
-        jnp.where(keep, 1.0, pid.factormin),
-        jnp.where(keep, pid.factormax, pid.safety),
-    )
-    tprev = jnp.where(keep, st["tnext"], t0)
-    tnext = tprev + dt * factor
-    # section times: the accepted step's end *is* the sample when it lands on ts[k]
-    S = ts.shape[0]
-    hit = keep & (st["k"] < S) & (ts[jnp.minimum(st["k"], S - 1)] <= tprev)
-    k = st["k"] + hit.astype(jnp.int32)
-    tnext = jnp.where(k < S, jnp.minimum(ts[jnp.minimum(k, S - 1)], tnext), tnext)  # diffrax's _clip_t
-    tprev, tnext = clip_to_end(tprev, tnext, t1, st["floor"], keep)
-    # validity monitor at the accepted step's end (N, den from the FSAL evaluation)
-    N, den = aux
-    kind = invalid_kind(N, den, y1[8])
-    new_invalid = keep & (kind > 0) & (st["first_invalid_kind"] == 0)
-    result = st["result"]
-    if cfg.stop_on_invalid:
-        result = R.where(new_invalid & (result == R.successful), R.event_occurred, result)
-    num_steps = st["num_steps"] + 1
-    done = (result != R.successful) | (tprev >= t1) | (num_steps >= cfg.max_steps)
-    new = dict(
-        st,
-        y=jnp.where(keep, y1, y0),
-        f=jnp.where(keep, fi, st["f"]),
-        tprev=tprev,
-        tnext=tnext,
-        first_invalid_t=jnp.where(new_invalid, tprev, st["first_invalid_t"]),
-        first_invalid_kind=jnp.where(new_invalid, kind, st["first_invalid_kind"]),
-        min_N=jnp.where(keep, jnp.minimum(st["min_N"], N), st["min_N"]),
-        min_n3=jnp.where(keep, jnp.minimum(st["min_n3"], y1[8]), st["min_n3"]),
-        result=result,
-        num_steps=num_steps,
-        k=k,
-        done=done,
-    )
-    return new, hit
-
-
-def _lane_step(cfg: SweepConfig, st: dict[str, Any]) -> tuple[dict[str, Any], Array]:
-    """One iteration of diffrax's integration loop (`diffrax._integrate.loop.body_fun_aux`) for
-    one lane, with exact section saving (the controller steps onto every section time, so the
-    accepted step's end state *is* the sample) and the stop-on-invalid event. Returns the new
-    state and whether this step's end is a section sample."""
-    R = diffrax.RESULTS
-    _, solver, term = _pool_parts(cfg)
-    p, ts, t1 = st["p"], st["ts"], st["t1"]
-    keep, y1, tprev, tnext, sstate, cstate, sres, cres = loop_step(
-        solver, term, _controller(st["tols"], ts), t1, st["floor"], st["tprev"], st["tnext"], st["y"], p,
-        st["sstate"], st["cstate"],
+def _stepper(cfg: SweepConfig, opaque_true: Array | None = None) -> AbstractLaneStepper:
+    return make_stepper(
+        cfg.solver, cfg.contact_law, rtol=cfg.rtol, atol=cfg.atol, max_steps=cfg.max_steps,
+        stop_on_invalid=cfg.stop_on_invalid, opaque_true=opaque_true,
     )  # fmt: skip
-    y = jnp.where(keep, y1, st["y"])
-    sstate = jax.tree_util.tree_map(lambda a, b: jnp.where(keep, a, b), sstate, st["sstate"])
-    sres = R.where(keep, sres, R.successful)
-    result = R.where(st["result"] == R.successful, sres, st["result"])
-    result = R.where(result == R.successful, cres, result)
-    num_steps = st["num_steps"] + 1
-    S = ts.shape[0]
-    hit = keep & (st["k"] < S) & (ts[jnp.minimum(st["k"], S - 1)] <= tprev)
-    k = st["k"] + hit.astype(jnp.int32)
-    if cfg.stop_on_invalid:
-        # diffrax.Event(cond = state invalid) without root finding: ends at the first accepted
-        # step whose end state is invalid -- exactly where the monitor first records it
-        ev = keep & (sstate[1].first_invalid_kind > 0) & (result == R.successful)
-        result = R.where(ev, R.event_occurred, result)
-    ok = result == R.successful
-    done = ~ok | (tprev >= t1) | (num_steps >= cfg.max_steps)
-    new = dict(
-        st,
-        y=y,
-        tprev=tprev,
-        tnext=tnext,
-        sstate=sstate,
-        cstate=cstate,
-        result=result,
-        num_steps=num_steps,
-        k=k,
-        done=done,
-    )
-    return new, hit
-
-
-def _lane_status(st: dict[str, Any]) -> Array:
-    # a lane that is still "successful" but has not reached t1 ran out of steps: status 1
-    ok = st["result"] == diffrax.RESULTS.successful
-    return jnp.where(ok, jnp.where(st["tprev"] >= st["t1"], 0, 1), status_code(st["result"])).astype(jnp.int32)
-
-
-def _param_split(pb: CeltParams, vary: tuple[bool, ...]) -> tuple[tuple[Array, ...], Callable[[Any], CeltParams]]:
-    """(the lane-varying leaves of ``pb``, a function rebuilding one lane's params from them).
-
-    ``vary`` (static, one flag per leaf of ``pb``): the parameters that differ between lanes.
-    Only those ride in the slots; the others enter the step as unbatched constants, so XLA
-    computes what depends on them alone (inertia adjugate, elliptic integrals, b_Ts^m_Ts, ...)
-    once instead of in every slot at every stage."""
-    leaves, treedef = jax.tree_util.tree_flatten(pb)
-    const = [x[0] for x in leaves]
-    pv_all = tuple(x for x, v in zip(leaves, vary) if v)
-
-    def params_of(pv):
-        it = iter(pv)
-        return jax.tree_util.tree_unflatten(treedef, [next(it) if v else c for v, c in zip(vary, const)])
-
-    return pv_all, params_of
 
 
 def _section_times(pb: CeltParams, transient: Array, cfg: SweepConfig) -> Array:
@@ -506,166 +285,6 @@ def _section_times(pb: CeltParams, transient: Array, cfg: SweepConfig) -> Array:
     T = 2 * jnp.pi / pb.omega_pi
     S = cfg.sample_periods
     return jnp.asarray(cfg.t0, jnp.float64) + T[:, None] * (transient + jnp.arange(S, dtype=jnp.float64))[None, :]
-
-
-_SLOT_ONLY = ("p", "ts")  # slot fields rebuilt from the lane's parameters, not stored per lane
-
-
-def _init_lanes(
-    pb: CeltParams, y0b: Array, live: Array, transient: Array, tols: Array, cfg: SweepConfig, vary: tuple[bool, ...]
-) -> tuple[dict[str, Array], Array]:
-    """Every lane's starting state (diffeqsolve's initialisation) and the samples buffer.
-
-    ``live`` (L,) bool: False marks padding lanes, which start done. A section time at t0
-    (transient 0) is the initial state itself: written here."""
-    pv_all, params_of = _param_split(pb, vary)
-    ts_all = _section_times(pb, transient, cfg)
-    st = jax.vmap(lambda pv, y, ts: _lane_init(cfg, params_of(pv), y, ts, tols))(pv_all, y0b, ts_all)
-    ls = {k: v for k, v in st.items() if k not in _SLOT_ONLY}
-    ls["done"] = ls["done"] | ~live
-    ls["resumed"] = jnp.zeros_like(ls["done"])  # paused once and taken up again (pauses only once)
-    L, S = y0b.shape[0], cfg.sample_periods
-    samples = jnp.full((L, S, 13), jnp.inf).at[:, 0].set(jnp.where((ls["k"] > 0)[:, None], y0b, jnp.inf))
-    return ls, samples
-
-
-def _pool(
-    pb: CeltParams,
-    ls: dict[str, Array],
-    samples: Array,
-    pause_frac: Array,
-    transient: Array,
-    cfg: SweepConfig,
-    width: int,
-    vary: tuple[bool, ...],
-    opaque_true: Array,
-) -> tuple[dict[str, Array], Array, Array, Array]:
-    """The lanes of ``ls`` that are not done yet, in order, through ``width`` slots (refilled
-    as lanes finish).
-
-    ``ls``: every lane's state (`_init_lanes`); a lane is taken from it when a slot is free
-    and written back when it is done or paused. A lane pauses at
-    the end of its first step past t0 + ``pause_frac`` (t1 - t0) (inf: never): it stops
-    between two steps, so resuming it from ``ls`` continues the very same step sequence.
-    ``samples`` (L, S, 13): the section buffer, written in place. ``vary``: see
-    `_param_split`. ``opaque_true``: a traced True (a jit argument, not a Python bool: XLA
-    would fold a constant predicate and the boundary would vanish) for `_kernel_boundary`.
-    Returns (ls, samples, loop iterations, step slots paid).
-    """
-    pv_all, params_of = _param_split(pb, vary)
-    L = samples.shape[0]
-    B = min(width, L)
-    # the queue: lanes with work (not padding, not invalid at t0 with stop_on_invalid), in order
-    queue = jnp.argsort(ls["done"], stable=True).astype(jnp.int32)
-    n_queue = jnp.sum(~ls["done"]).astype(jnp.int32)
-    ts_all = _section_times(pb, transient, cfg)
-    t0 = jnp.asarray(cfg.t0, jnp.float64)
-    tab = _erk_tableau(cfg)
-
-    def _step(st):
-        pv = st["p"]
-        st = dict(st, p=params_of(pv))
-        if tab is None:
-            new, hit = _lane_step(cfg, st)
-        else:
-            new, hit = _erk_lane_step(cfg, tab, st, _kernel_boundary(jnp.asarray(opaque_true)))
-        paused = ~new["done"] & ~st["resumed"] & (new["tprev"] >= t0 + pause_frac * (new["t1"] - t0))
-        return dict(new, p=pv), hit, paused
-
-    step_v = jax.vmap(_step)
-
-    def take(lane, ls):
-        j = jnp.minimum(lane, L - 1)
-        st = jax.tree_util.tree_map(lambda x: x[j], ls)
-        return dict(st, p=tuple(x[j] for x in pv_all), ts=ts_all[j])
-
-    def lane_at(pos):
-        return jnp.where(pos < n_queue, queue[jnp.minimum(pos, L - 1)], L).astype(jnp.int32)
-
-    lane = lane_at(jnp.arange(B, dtype=jnp.int32))
-    slots = take(lane, ls)
-    no = jnp.asarray(-jnp.inf)
-
-    def body(c):
-        slots, lane, nxt, wait, ls, samples, iters, slot_steps = c
-        active = (lane < L) & ~slots["done"]
-        stepped, hit, paused = step_v(slots)
-        slots = jax.tree_util.tree_map(
-            lambda a, b: jnp.where(jnp.reshape(active, active.shape + (1,) * (a.ndim - 1)), a, b), stepped, slots
-        )
-        w = jnp.where(active & hit, lane, L)
-        samples = samples.at[w, slots["k"] - 1].set(slots["y"], mode="drop")
-        pause = active & paused
-        fin = (lane < L) & (slots["done"] | pause)
-
-        def swap(args):
-            # Write finished and paused lanes back; a paused lane waits with its predicted
-            # remaining cost (steps so far x remaining / elapsed time span) as priority.
-            # Free slots take the queue's next lanes, then the waiting lanes, costliest first.
-            slots, lane, nxt, wait, ls = args
-            wb = jnp.where(fin, lane, L)
-            slots = dict(slots, resumed=slots["resumed"] | pause)
-            ls = jax.tree_util.tree_map(lambda a, s: a.at[wb].set(s, mode="drop"), ls, {k: slots[k] for k in ls})
-            elapsed = slots["tprev"] - t0
-            cost = slots["num_steps"] * (slots["t1"] - slots["tprev"]) / jnp.where(elapsed > 0, elapsed, 1.0)
-            wait = wait.at[jnp.where(pause, lane, L)].set(cost.astype(wait.dtype), mode="drop")
-            rank = jnp.cumsum(fin.astype(jnp.int32)) - 1
-            from_queue = nxt + rank < n_queue
-            by_cost = jnp.argsort(-wait)  # waiting lanes first (the others wait at -inf)
-            pick = by_cost[jnp.clip(rank - jnp.maximum(n_queue - nxt, 0), 0, L - 1)]
-            new_lane = jnp.where(from_queue, lane_at(nxt + rank), jnp.where(wait[pick] > no, pick, L))
-            new_lane = jnp.where(fin, new_lane, lane).astype(jnp.int32)
-            refill = fin & (new_lane < L)
-            wait = wait.at[jnp.where(refill & ~from_queue, new_lane, L)].set(no, mode="drop")
-            nxt = nxt + jnp.sum(refill & from_queue).astype(jnp.int32)
-            fresh = take(new_lane, ls)
-            slots = jax.tree_util.tree_map(
-                lambda a, b: jnp.where(jnp.reshape(refill, refill.shape + (1,) * (a.ndim - 1)), a, b), fresh, slots
-            )
-            return slots, jnp.where(fin, jnp.where(refill, new_lane, L), lane).astype(jnp.int32), nxt, wait, ls
-
-        slots, lane, nxt, wait, ls = jax.lax.cond(jnp.any(fin), swap, lambda a: a, (slots, lane, nxt, wait, ls))
-        return slots, lane, nxt, wait, ls, samples, iters + 1, slot_steps + lane.shape[0]
-
-    # The drain: once no more than half of the slots have work left (running lanes plus lanes
-    # not yet started), the running lanes are gathered into a pool half as wide and go on
-    # there (widths B, B/2, B/4, ... down to 16), so that the end of a chunk does not pay for
-    # idle slots at the full width's cost. Per-lane results do not depend on the width
-    # (same steps and statuses, samples to rounding; tested). Each width compiles the step
-    # again (~9 s on CPU), so only pools with a queue (more lanes than slots) do this.
-    widths = [B]
-    while L > B and widths[-1] // 2 >= MIN_DRAIN_WIDTH:
-        widths.append(widths[-1] // 2)
-    z = jnp.zeros((), jnp.int32)
-    wait = jnp.full((L,), -jnp.inf)  # paused lanes: their predicted remaining cost
-    carry = (slots, lane, jnp.minimum(jnp.asarray(B, jnp.int32), n_queue), wait, ls, samples, z, z)
-    for nxt_w in [*widths[1:], 0]:
-
-        def cond(c, nxt_w=nxt_w):
-            work = jnp.sum(c[1] < L) + jnp.maximum(n_queue - c[2], 0) + jnp.sum(c[3] > -jnp.inf)
-            return jnp.any(c[1] < L) & (work > nxt_w)
-
-        carry = jax.lax.while_loop(cond, body, carry)
-        if nxt_w:
-            slots, lane = carry[0], carry[1]
-            keep = jnp.argsort(lane >= L, stable=True)[:nxt_w]  # the running lanes first
-            carry = (jax.tree_util.tree_map(lambda x, keep=keep: x[keep], slots), lane[keep], *carry[2:])
-    _, _, _, _, ls, samples, iters, slot_steps = carry
-    return ls, samples, iters, slot_steps
-
-
-def _lane_outputs(ls: dict[str, Array]) -> dict[str, Array]:
-    """Per-lane results from the final lane states."""
-    first_t, first_kind, min_N, max_tilt = jax.vmap(_lane_monitor)(ls)
-    return dict(
-        y_final=ls["y"],
-        status=jax.vmap(_lane_status)(ls),
-        num_steps=ls["num_steps"],
-        first_invalid_t=first_t,
-        first_invalid_kind=first_kind.astype(jnp.int32),
-        min_N=min_N,
-        max_tilt=max_tilt,
-    )
 
 
 def _lyap_lane(p: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig) -> Array:
@@ -683,13 +302,6 @@ def _lyap_lane(p: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig) 
     return lr.exponent
 
 
-def _sharded(run: Callable, mesh: Any, n_in: int) -> Callable:
-    if mesh is None:
-        return run
-    spec = jax.sharding.PartitionSpec("lanes")
-    return jax.shard_map(run, mesh=mesh, in_specs=(spec,) * n_in, out_specs=spec, check_vma=False)
-
-
 @eqx.filter_jit
 def _pool_chunk(
     pb: CeltParams,
@@ -704,47 +316,34 @@ def _pool_chunk(
     vary: tuple[bool, ...],
     opaque_true: Array,
 ) -> tuple[dict[str, Array], Array, Array]:
-    def run(pb, y0b, live):
-        ls, samples = _init_lanes(pb, y0b, live, transient, tols, cfg, vary)
-        ls, samples, iters, slot_steps = _pool(pb, ls, samples, pause_frac, transient, cfg, width, vary, opaque_true)
-        out = dict(_lane_outputs(ls), samples=samples, t_samples=_section_times(pb, transient, cfg))
-        out.update(jax.vmap(_extras)(samples, pb))
-        return out, iters[None], slot_steps[None]  # loop counters: one per device
+    """One chunk of lanes through the pool (per device): per-lane outputs and the loop counters.
 
-    return _sharded(run, mesh, 3)(pb, y0b, live)
+    ``opaque_true``: a traced True (a jit argument: XLA would fold a constant predicate and the
+    fused step's kernel boundaries would vanish). ``vary``: `jaxcelt.ensemble.split_lane_args`."""
+
+    def run(pb, y0b, live):
+        stepper = _stepper(cfg, opaque_true)
+        pv_all, params_of = split_lane_args(pb, vary)
+        ts_all = _section_times(pb, transient, cfg)
+        t0 = jnp.asarray(cfg.t0, jnp.float64)
+        lanes, samples = start_lanes(stepper, pv_all, params_of, y0b, ts_all, live, tols, t0)
+        lanes, samples, stats = run_pool(
+            stepper, lanes, samples, pv_all, params_of, ts_all, t0, width=width, pause_frac=pause_frac
+        )
+        out = dict(lane_outputs(stepper, lanes).as_dict(), samples=samples, t_samples=ts_all)
+        out.update(jax.vmap(_extras)(samples, pb))
+        return out, stats.iterations[None], stats.slot_steps[None]  # loop counters: one per device
+
+    return shard_lanes(run, mesh, 3)(pb, y0b, live)
 
 
 @eqx.filter_jit
 def _lyap_chunk(pb: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig, mesh: Any) -> Array:
     run = jax.vmap(lambda p, y, t: _lyap_lane(p, y, t, cfg))
-    return _sharded(run, mesh, 3)(pb, y_start, t_start)
+    return shard_lanes(run, mesh, 3)(pb, y_start, t_start)
 
 
-def _mesh(devices: Sequence[Any] | None) -> Any:
-    devs = list(devices) if devices is not None else jax.local_devices()
-    if len(devs) <= 1:
-        return None
-    return jax.sharding.Mesh(np.array(devs), ("lanes",))
-
-
-def _pad(x: np.ndarray, n: int) -> np.ndarray:
-    if len(x) == n:
-        return x
-    return np.concatenate([x, np.repeat(x[-1:], n - len(x), axis=0)])
-
-
-DEFAULT_WIDTH = 96
-"""pool slots per device. Each pool iteration pays a fixed cost (~330 XLA kernel launches,
-~30 us on CPU) besides its per-slot work, so wider pools finish in fewer iterations; with the
-pilot pause, 96 was fastest for 400 lanes x 300 periods on 2 cores
-(``benchmarks/bench_schedule.py``; docs/bifurcation/README.md)."""
-MIN_DRAIN_WIDTH = 16  # narrowest pool of the drain (narrower costs more per slot than it saves)
-PILOT_FRACTION = 0.1
-"""a lane pauses once after this fraction of its time span and waits for a slot with its
-predicted remaining cost (see `_pool`; ``benchmarks/bench_schedule.py``)"""
-
-
-def run_lanes(
+def run_lanes_with_stats(
     pb: CeltParams,
     y0b: Array,
     cfg: SweepConfig,
@@ -755,34 +354,15 @@ def run_lanes(
     compile_only: bool = False,
     varying: Sequence[str] = (),
     pilot_fraction: float = PILOT_FRACTION,
-) -> dict[str, np.ndarray]:
-    """Run one chunk of lanes (batched params and y0 with a leading lane axis) and return numpy arrays.
-
-    ``width`` batch slots per device (default
-    `DEFAULT_WIDTH`) step in one jitted while loop; a slot whose lane finishes is refilled
-    with the next lane at once, so no slot idles until the slowest lane is done (only the
-    final drain does). ``pilot_fraction`` (default `PILOT_FRACTION`; 0 = off; only used
-    when a device has more lanes than slots): each lane pauses once after this fraction of
-    its time span and is taken up again costliest-predicted first (see `_pool`). The Lyapunov stage (``cfg.lyapunov_periods > 0``) then runs vmapped
-    over the successful lanes in groups of ``width`` ordered by the measured main-solve
-    step count (a cost estimate that needs no pilot run).
-
-    Sharded over ``devices`` (default all local devices; lanes are dealt round-robin); padded
-    to ``pad_to`` lanes (so a short last chunk reuses the compiled shape) and to a multiple
-    of the device count. Padding lanes are dropped; in the pool they finish at once.
-    ``compile_only=True`` (pool): every lane marked as padding -- compiles the kernel for
-    these shapes and returns at once (used to time compilation apart from running).
-    ``varying``: names of parameters to treat as differing between lanes even where this
-    chunk's lanes happen to share a value (parameters that do differ are always detected),
-    so that all chunks of a sweep compile to one kernel; the others are constants of the
-    pool's step (see `_pool`).
-    """
-    mesh = _mesh(devices)
+) -> tuple[dict[str, np.ndarray], PoolStats]:
+    """`run_lanes`, with the pool's statistics apart: (per-lane numpy arrays, `PoolStats` over
+    all devices: the busiest device's iterations, the step slots paid by all, the width)."""
+    mesh = device_mesh(devices)
     L = int(np.shape(y0b)[0])
     ndev = 1 if mesh is None else mesh.devices.size
     Lp = math.ceil(max(L, pad_to or 0) / ndev) * ndev
-    pb_np = jax.tree_util.tree_map(lambda x: _pad(np.asarray(x), Lp), pb)
-    y0_np = _pad(np.asarray(y0b, dtype=np.float64), Lp)
+    pb_np = jax.tree_util.tree_map(lambda x: pad_lanes(np.asarray(x), Lp), pb)
+    y0_np = pad_lanes(np.asarray(y0b, dtype=np.float64), Lp)
     static_cfg = dataclasses.replace(cfg, transient_periods=0)  # transient is traced: no recompiles
     transient = jnp.asarray(float(cfg.transient_periods))
     W = int(width or DEFAULT_WIDTH)
@@ -807,14 +387,11 @@ def run_lanes(
     out, iters, slot_steps = _pool_chunk(
         pb_p, y0_np[pos_lane], live, jnp.asarray(frac), transient, tols, nocfg, Wd, mesh, vary, jnp.asarray(True)
     )
-    iters, slot_steps = np.asarray(iters), int(np.sum(np.asarray(slot_steps)))
+    stats = PoolStats(iterations=int(np.asarray(iters).max()), slot_steps=int(np.sum(np.asarray(slot_steps))), width=Wd)
     out = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(out))
     inv = np.empty_like(pos_lane)
     inv[pos_lane] = np.arange(Lp)
     out = {k: v[inv][:L] for k, v in out.items()}
-    out["pool_iterations"] = np.full(L, int(iters.max()))  # the busiest device's loop iterations
-    out["pool_slot_steps"] = np.full(L, slot_steps)  # step slots paid, over all devices and widths
-    out["pool_width"] = np.full(L, Wd)
     out["valid"] = out["first_invalid_kind"] == 0
     out["lyapunov"] = np.full(L, np.nan)
     if cfg.lyapunov_periods > 0 and not compile_only:
@@ -822,7 +399,7 @@ def run_lanes(
         ok = ok[np.argsort(-out["num_steps"][ok], kind="stable")]  # similar cost side by side
         G = W * ndev
         for i in range(0, len(ok), G):
-            idx = _pad(ok[i : i + G], G)
+            idx = pad_lanes(ok[i : i + G], G)
             lam = _lyap_chunk(
                 jax.tree_util.tree_map(lambda x, idx=idx: x[idx], pb_np),
                 out["samples"][idx, 0],
@@ -832,6 +409,54 @@ def run_lanes(
             )
             n = min(G, len(ok) - i)
             out["lyapunov"][idx[:n]] = np.asarray(lam)[:n]
+    return out, stats
+
+
+def run_lanes(
+    pb: CeltParams,
+    y0b: Array,
+    cfg: SweepConfig,
+    *,
+    devices: Sequence[Any] | None = None,
+    pad_to: int | None = None,
+    width: int | None = None,
+    compile_only: bool = False,
+    varying: Sequence[str] = (),
+    pilot_fraction: float = PILOT_FRACTION,
+) -> dict[str, np.ndarray]:
+    """Run one chunk of lanes (batched params and y0 with a leading lane axis) and return numpy arrays.
+
+    ``width`` batch slots per device (default `DEFAULT_WIDTH`) step in one jitted while loop
+    (`jaxcelt.ensemble.run_pool`); a slot whose lane finishes is refilled with the next lane at
+    once, so no slot idles until the slowest lane is done (only the final drain does).
+    ``pilot_fraction`` (default `PILOT_FRACTION`; 0 = off; only used when a device has more
+    lanes than slots): each lane pauses once after this fraction of its time span and is taken
+    up again costliest-predicted first. The Lyapunov stage (``cfg.lyapunov_periods > 0``) then
+    runs vmapped over the successful lanes in groups of ``width`` ordered by the measured
+    main-solve step count (a cost estimate that needs no pilot run).
+
+    Sharded over ``devices`` (default all local devices; lanes are dealt round-robin); padded
+    to ``pad_to`` lanes (so a short last chunk reuses the compiled shape) and to a multiple
+    of the device count. Padding lanes are dropped; in the pool they finish at once.
+    ``compile_only=True``: every lane marked as padding -- compiles the kernel for these
+    shapes and returns at once (used to time compilation apart from running).
+    ``varying``: names of parameters to treat as differing between lanes even where this
+    chunk's lanes happen to share a value (parameters that do differ are always detected),
+    so that all chunks of a sweep compile to one kernel; the others are constants of the
+    pool's step.
+
+    Returns the fields of `SweepResult` but ``values`` (lane axis first), and the pool's
+    statistics copied into every lane: ``pool_iterations``, ``pool_slot_steps``,
+    ``pool_width`` (`run_lanes_with_stats` returns them apart, as `PoolStats`).
+    """
+    out, stats = run_lanes_with_stats(
+        pb, y0b, cfg, devices=devices, pad_to=pad_to, width=width, compile_only=compile_only, varying=varying,
+        pilot_fraction=pilot_fraction,
+    )  # fmt: skip
+    L = len(out["status"])
+    out["pool_iterations"] = np.full(L, stats.iterations)  # the busiest device's loop iterations
+    out["pool_slot_steps"] = np.full(L, stats.slot_steps)  # step slots paid, over all devices and widths
+    out["pool_width"] = np.full(L, stats.width)
     return out
 
 
