@@ -5,7 +5,9 @@
   `FusedERKStepper` (explicit FSAL Runge-Kutta, fused), behind `AbstractLaneStepper`;
 * `pool`: `run_pool`, lanes through a fixed number of refilled batch slots in one jitted
   while loop, with `PoolStats`;
-* `shard`: lanes over devices.
+* `shard`: lanes over devices;
+* `stroboscopic`: `run_lanes`, one chunk of lanes sampled at the forcing's section times
+  (`SweepConfig`), sharded over devices, with the optional Lyapunov stage.
 
 The user-facing sweeps (`jaxcelt.sweep`: `bifurcation`, `parameter_map`, ...) are built on it.
 The diffrax internals it mirrors live in `jaxcelt._diffrax_adapter`.
@@ -34,3 +36,7 @@ from .stepper import FusedStepState as FusedStepState
 from .stepper import erk_tableau as erk_tableau
 from .stepper import kernel_boundary as kernel_boundary
 from .stepper import make_stepper as make_stepper
+from .stroboscopic import SweepConfig as SweepConfig
+from .stroboscopic import lanes_params as lanes_params
+from .stroboscopic import run_lanes as run_lanes
+from .stroboscopic import run_lanes_with_stats as run_lanes_with_stats
