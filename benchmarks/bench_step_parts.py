@@ -1,6 +1,6 @@
 """Where a sweep step's time goes: per-lane cost of one vector-field evaluation, diffrax's
 Tsit5 step with `MonitoredSolver` (what `simulate` runs: 6 RHS + RK bookkeeping + the monitor's
-extra normal-force evaluation), the pool's fused step (`jaxcelt.sweep._erk_lane_step`: 6 RHS,
+extra normal-force evaluation), the pool's fused step (`jaxcelt.ensemble.FusedERKStepper`: 6 RHS,
 monitor from the FSAL evaluation, PID + section clipping) with and without its stage-input
 kernel boundaries, and the full pool iteration is `bench_pool_width.py`'s business. Each part
 is vmapped over the lanes inside one jitted loop (no dispatch), best of 5, one JAX device.
@@ -17,23 +17,17 @@ import os
 import time
 from pathlib import Path
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
 
 import jaxcelt as jc
 from jaxcelt.contact import get_contact_law
+from jaxcelt.ensemble import make_stepper
 from jaxcelt.model import vector_field
-from jaxcelt.solve import _invalid_kind
-from jaxcelt.sweep import (
-    SweepConfig,
-    _erk_lane_step,
-    _erk_tableau,
-    _kernel_boundary,
-    _lane_init,
-    _pool_parts,
-    lanes_params,
-)
+from jaxcelt.solve import DEFAULT_SOLVER, _invalid_kind
+from jaxcelt.sweep import lanes_params
 
 PARTS = (
     "rhs",
@@ -80,28 +74,33 @@ def step_parts(p, vals, y0, *, reps: int = 2000, n_samples: int = 100, parts=PAR
     if not any(name in parts for name in PARTS[2:]):
         return out
 
-    cfg = SweepConfig(transient_periods=0, sample_periods=n_samples, stop_on_invalid=True)
-    _, solver, term = _pool_parts(cfg)
-    tab = _erk_tableau(cfg)
+    def stepper(opaque_true=None):  # the pool's stepper for the default solver (fused Tsit5)
+        kw = dict(rtol=1e-8, atol=1e-10, max_steps=1_000_000, stop_on_invalid=True, opaque_true=opaque_true)
+        return make_stepper(DEFAULT_SOLVER, None, **kw)
+
+    fused0 = stepper()
+    solver, term = fused0.solver, fused0.term  # `MonitoredSolver` around Tsit5, the wrapped term
     tols = jnp.asarray([1e-8, 1e-10])
     ts = (2 * jnp.pi / pb.omega_pi)[:, None] * jnp.arange(float(n_samples))[None]
-    st0 = jax.jit(jax.vmap(lambda pp, y, t: _lane_init(cfg, pp, y, t, tols)))(pb, y0, ts)
+    t0 = jnp.asarray(0.0)
+    st0 = jax.jit(jax.vmap(lambda pp, y, t: fused0.init(t0, y, t, pp, tols)))(pb, y0, ts)
     # diffrax's path needs its own solver state (the fused step's lane state has none)
-    st_d = dict(st0, sstate=jax.jit(jax.vmap(lambda s: solver.init(term, s["tprev"], s["tnext"], s["y"], s["p"])))(st0))
+    ss0 = jax.jit(jax.vmap(lambda s, pp: solver.init(term, s.tprev, s.tnext, s.y, pp)))(st0, pb)
 
-    def diffrax_step(s):  # the wrapped diffrax Tsit5 step + validity monitor, as in `simulate`
-        y1, _, _, ss, _ = jax.vmap(lambda s: solver.step(term, s["tprev"], s["tnext"], s["y"], s["p"], s["sstate"], False))(s)  # fmt: skip
-        return dict(s, y=y1, sstate=ss)
+    def diffrax_step(s, flag):  # the wrapped diffrax Tsit5 step + validity monitor, as in `simulate`
+        st, ss = s
+        y1, _, _, ss, _ = jax.vmap(lambda s, pp, ss: solver.step(term, s.tprev, s.tnext, s.y, pp, ss, False))(st, pb, ss)  # fmt: skip
+        return eqx.tree_at(lambda s: s.y, st, y1), ss
 
     def fused(boundaries):
         def step(s, flag):
-            b = _kernel_boundary(flag) if boundaries else (lambda x: x)
-            return jax.vmap(lambda s: _erk_lane_step(cfg, tab, s, b))(s)[0]
+            fs = stepper(flag if boundaries else None)
+            return jax.vmap(lambda s, pp, t: fs.step(s, pp, t))(s, pb, ts)[0]
 
         return step
 
     runs = {
-        "diffrax tsit5 step + monitor": (lambda s, flag: diffrax_step(s), st_d),
+        "diffrax tsit5 step + monitor": (diffrax_step, (st0, ss0)),
         "fused step, no stage boundaries": (fused(False), st0),
         "fused step (pool)": (fused(True), st0),
     }

@@ -34,7 +34,9 @@ from jaxcelt.versions import versions  # noqa: E402
 def tsit5_tableau():
     """Tsitouras 5(4) in the numba loop's layout (C, A (7x7, row 6 = b), B5, E)."""
     # the public coefficients, as diffrax ships them (diffrax.Tsit5's ButcherTableau)
-    from diffrax._solver.tsit5 import _tsit5_tableau as t  # benchmark only: a private table of coefficients
+    import diffrax
+
+    t = diffrax.Tsit5.tableau  # public class attribute: the ButcherTableau
 
     C = np.r_[0.0, t.c]
     A = np.zeros((7, 7))

@@ -33,9 +33,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
-from diffrax._root_finder import use_stepsize_tol  # not re-exported at top level
 
 from . import _config  # noqa: F401
+from ._diffrax_adapter import use_stepsize_tol
 from .contact import AbstractContactLaw, get_contact_law
 from .params import CeltParams
 from .solve import simulate

@@ -21,9 +21,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
-from diffrax._root_finder import use_stepsize_tol  # not re-exported at top level
 
 from . import _config  # noqa: F401
+from ._diffrax_adapter import use_stepsize_tol
 from ._types import Array, ArrayLike, Scalar
 from .contact import AbstractContactLaw, get_contact_law
 from .model import contact_loads, kinematics, normal_force_parts, vector_field

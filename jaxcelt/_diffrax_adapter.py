@@ -1,0 +1,101 @@
+"""The diffrax and equinox internals jaxcelt relies on, in one place.
+
+jaxcelt uses diffrax's public API everywhere except where it has to reproduce what
+`diffrax.diffeqsolve` does inside its loop: the lane pool (`jaxcelt.ensemble`) steps many
+solves side by side in its own while loop and must take the same steps as `diffeqsolve`, and
+`jaxcelt.solve` passes diffrax's "use the step-size tolerances" marker to an implicit solver's
+root finder. The names below are not re-exported by diffrax or equinox, or mirror the body of
+diffrax's integration loop (``diffrax/_integrate.py``: ``loop``, ``body_fun_aux``,
+``_clip_to_end``), so they can change in any release. The versions they were written against
+are the ranges pinned in ``pyproject.toml``; ``tests/test_ensemble_adapter.py`` checks that the
+installed diffrax and equinox are inside them, that the names still exist, and that
+`loop_init` + `loop_step` take the same steps as `diffrax.diffeqsolve` on a small ODE.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import diffrax
+import equinox.internal as eqxi
+import jax.numpy as jnp
+from diffrax._root_finder import use_stepsize_tol  # not re-exported at top level
+from diffrax._term import WrapTerm  # what diffeqsolve wraps terms in (not re-exported)
+
+from ._types import Array
+
+__all__ = ["use_stepsize_tol", "wrap_term", "t1_clip_floor", "clip_to_end", "loop_init", "loop_step"]
+
+
+def wrap_term(term: diffrax.AbstractTerm) -> diffrax.AbstractTerm:
+    """``term`` as `diffeqsolve` hands it to the solver and controller of a forward solve.
+
+    diffeqsolve wraps every term in ``WrapTerm(term, direction)``; with it,
+    ``PIDController.init`` takes diffrax's fixed first trial step (0.01) instead of the
+    ODETerm-only heuristic, so a loop that wants the same steps as diffeqsolve must wrap too."""
+    return WrapTerm(term, jnp.asarray(1))
+
+
+def t1_clip_floor(t1: Array) -> Array:
+    """t1 - 100 ULP: diffeqsolve rounds a proposed step end above this onto t1."""
+    floor = t1
+    for _ in range(100):
+        floor = eqxi.prevbefore(floor)
+    return floor
+
+
+def clip_to_end(tprev: Array, tnext: Array, t1: Array, floor: Array, keep: Array) -> tuple[Array, Array]:
+    """diffeqsolve's bookkeeping after the controller: ``tprev`` capped at t1 and a next step
+    end within ~100 ULP of t1 moved onto t1 (accepted step) or halfway there (rejected)."""
+    tprev = jnp.minimum(tprev, t1)
+    tnext = jnp.where(tnext > floor, jnp.where(keep, t1, tprev + 0.5 * (t1 - tprev)), tnext)
+    return tprev, tnext
+
+
+def loop_init(
+    solver: diffrax.AbstractSolver,
+    term: diffrax.AbstractTerm,
+    controller: diffrax.AbstractAdaptiveStepSizeController,
+    t0: Array,
+    t1: Array,
+    y0: Array,
+    args: Any,
+    *,
+    solver_state: bool = True,
+) -> tuple[Array, Any, Any]:
+    """diffeqsolve's initialisation of a forward solve with ``dt0=None``: (first step end,
+    controller state, solver state or None if ``solver_state=False``). ``term``: from
+    `wrap_term`."""
+    tnext, cstate = controller.init(term, t0, t1, y0, None, args, solver.func, solver.error_order(term))
+    tnext = jnp.minimum(tnext, t1)
+    sstate = solver.init(term, t0, tnext, y0, args) if solver_state else None
+    return tnext, cstate, sstate
+
+
+def loop_step(
+    solver: diffrax.AbstractSolver,
+    term: diffrax.AbstractTerm,
+    controller: diffrax.AbstractAdaptiveStepSizeController,
+    t1: Array,
+    floor: Array,
+    tprev: Array,
+    tnext: Array,
+    y: Array,
+    args: Any,
+    sstate: Any,
+    cstate: Any,
+) -> tuple[Array, Array, Array, Array, Any, Any, Any, Any]:
+    """One step of diffeqsolve's loop body (``body_fun_aux``) without saving or events.
+
+    Returns (accepted, proposed y1, new tprev, new tnext, proposed solver state, controller
+    state, solver result, controller result); the caller keeps y1 and the solver state only
+    where the step was accepted, as diffeqsolve does. ``y``: one array (not a pytree);
+    ``floor``: `t1_clip_floor` (t1)."""
+    y1, y_err, _, sstate1, sres = solver.step(term, tprev, tnext, y, args, sstate, False)
+    # a NaN error estimate (e.g. a NaN vector field after too large a step) rejects the step
+    y_err = jnp.where(jnp.isnan(y_err), jnp.inf, y_err)
+    keep, tprev1, tnext1, _, cstate1, cres = controller.adapt_step_size(
+        tprev, tnext, y, y1, args, y_err, solver.error_order(term), cstate
+    )
+    tprev1, tnext1 = clip_to_end(tprev1, tnext1, t1, floor, keep)
+    return keep, y1, tprev1, tnext1, sstate1, cstate1, sres, cres

@@ -1,0 +1,42 @@
+"""The lane engine: many ODE solves side by side, each exactly as `jaxcelt.simulate` takes it.
+
+* `lanes`: `LaneState` (one solve between two steps) and the per-lane outputs;
+* `stepper`: one step of one lane -- `DiffraxStepper` (diffrax's own step) or
+  `FusedERKStepper` (explicit FSAL Runge-Kutta, fused), behind `AbstractLaneStepper`;
+* `pool`: `run_pool`, lanes through a fixed number of refilled batch slots in one jitted
+  while loop, with `PoolStats`;
+* `shard`: lanes over devices;
+* `stroboscopic`: `run_lanes`, one chunk of lanes sampled at the forcing's section times
+  (`SweepConfig`), sharded over devices, with the optional Lyapunov stage.
+
+The user-facing sweeps (`jaxcelt.sweep`: `bifurcation`, `parameter_map`, ...) are built on it.
+The diffrax internals it mirrors live in `jaxcelt._diffrax_adapter`.
+"""
+
+from .lanes import LaneMonitor as LaneMonitor
+from .lanes import LaneOutputs as LaneOutputs
+from .lanes import LaneState as LaneState
+from .lanes import lane_status as lane_status
+from .pool import DEFAULT_WIDTH as DEFAULT_WIDTH
+from .pool import MIN_DRAIN_WIDTH as MIN_DRAIN_WIDTH
+from .pool import PILOT_FRACTION as PILOT_FRACTION
+from .pool import PoolStats as PoolStats
+from .pool import lane_outputs as lane_outputs
+from .pool import run_pool as run_pool
+from .pool import split_lane_args as split_lane_args
+from .pool import start_lanes as start_lanes
+from .shard import device_mesh as device_mesh
+from .shard import pad_lanes as pad_lanes
+from .shard import shard_lanes as shard_lanes
+from .stepper import AbstractLaneStepper as AbstractLaneStepper
+from .stepper import DiffraxStepper as DiffraxStepper
+from .stepper import DiffraxStepState as DiffraxStepState
+from .stepper import FusedERKStepper as FusedERKStepper
+from .stepper import FusedStepState as FusedStepState
+from .stepper import erk_tableau as erk_tableau
+from .stepper import kernel_boundary as kernel_boundary
+from .stepper import make_stepper as make_stepper
+from .stroboscopic import SweepConfig as SweepConfig
+from .stroboscopic import lanes_params as lanes_params
+from .stroboscopic import run_lanes as run_lanes
+from .stroboscopic import run_lanes_with_stats as run_lanes_with_stats

@@ -1,0 +1,271 @@
+"""The lane pool: many lanes through a fixed number of batch slots in one jitted while loop.
+
+Each iteration makes one step (`jaxcelt.ensemble.stepper`) in every slot, vmapped; a slot
+whose lane finished is refilled with the next lane at once, so step slots are only wasted in
+the final drain, not for every lane until the slowest one is done. Lane order (and hence slot
+assignment) is fixed and the per-lane arithmetic does not depend on the slot, so results are
+deterministic and a lane's result does not depend on its neighbours.
+
+Scheduling:
+
+* When lanes queue for slots, every lane first runs a fraction of its time span
+  (``pause_frac``, `PILOT_FRACTION`) and pauses between two steps; paused lanes wait with
+  their predicted remaining cost (steps so far x remaining / elapsed span) and free slots take
+  them costliest first (longest-processing-time order), so the drain runs on short lanes. A
+  pause does not change a lane: it resumes with the same state and step sequence.
+* The drain: once no more than half of the slots have work left, the running lanes move to a
+  pool half as wide (widths B, B/2, ... down to `MIN_DRAIN_WIDTH`). Each width compiles the
+  step again, so only pools with a queue (more lanes than slots) do this.
+
+Only the lane-varying parameters ride in the slots (`split_lane_args`); the others enter the
+step as unbatched constants. How the loop went (iterations, step slots paid) comes back as
+`PoolStats`, apart from the lanes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any, NamedTuple
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+
+from .._types import Array
+from .lanes import LaneOutputs, LaneState, lane_status
+from .stepper import AbstractLaneStepper
+
+__all__ = [
+    "PoolStats",
+    "run_pool",
+    "start_lanes",
+    "lane_outputs",
+    "split_lane_args",
+    "DEFAULT_WIDTH",
+    "MIN_DRAIN_WIDTH",
+    "PILOT_FRACTION",
+]
+
+DEFAULT_WIDTH = 96
+"""pool slots per device. Each pool iteration pays a fixed cost (hundreds of XLA kernel
+launches on CPU) besides its per-slot work, so wider pools finish in fewer iterations; 96 was
+the fastest width for 400 lanes x 300 periods on 2 cores with the pilot pause
+(``benchmarks/bench_schedule.py``; docs/bifurcation/README.md)."""
+MIN_DRAIN_WIDTH = 16
+"""narrowest pool of the drain (narrower costs more per slot than it saves)"""
+PILOT_FRACTION = 0.1
+"""a lane pauses once after this fraction of its time span and waits for a slot with its
+predicted remaining cost (``benchmarks/bench_schedule.py``)"""
+
+
+class PoolStats(eqx.Module):
+    """How a pool ran. Inside the jitted pool: int32 counters of one device; from
+    `jaxcelt.sweep.run_lanes`: plain ints over all devices."""
+
+    iterations: Any
+    """loop iterations (every iteration steps every slot once); over devices: the busiest one's"""
+    slot_steps: Any
+    """step slots paid (slots x iterations, summed over the drain's widths; over devices: summed).
+    At least the lanes' total step count; the excess is idle slots."""
+    width: int = eqx.field(static=True)
+    """slots per device at the start"""
+
+
+def split_lane_args(pb: Any, vary: tuple[bool, ...]) -> tuple[tuple[Array, ...], Callable[[Any], Any]]:
+    """(the lane-varying leaves of ``pb``, a function rebuilding one lane's args from them).
+
+    ``pb``: the lanes' args (e.g. a batched `CeltParams`), leading lane axis on every leaf.
+    ``vary`` (static, one flag per leaf): the leaves that differ between lanes. Only those ride
+    in the slots; the others (taken from lane 0) enter the step as unbatched constants, so XLA
+    computes what depends on them alone (inertia adjugate, elliptic integrals, ...) once instead
+    of in every slot at every stage."""
+    leaves, treedef = jax.tree_util.tree_flatten(pb)
+    const = [x[0] for x in leaves]
+    pv_all = tuple(x for x, v in zip(leaves, vary) if v)
+
+    def args_of(pv):
+        it = iter(pv)
+        return jax.tree_util.tree_unflatten(treedef, [next(it) if v else c for v, c in zip(vary, const)])
+
+    return pv_all, args_of
+
+
+def start_lanes(
+    stepper: AbstractLaneStepper,
+    lane_args: tuple[Array, ...],
+    args_of: Callable[[Any], Any],
+    y0b: Array,
+    ts_all: Array,
+    live: Array,
+    tols: Array,
+    t0: Array,
+) -> tuple[LaneState, Array]:
+    """Every lane's starting state (diffeqsolve's initialisation) and the samples buffer.
+
+    ``lane_args``/``args_of``: from `split_lane_args`; ``y0b`` (L, n); ``ts_all`` (L, S) section
+    times; ``live`` (L,) bool: False marks padding lanes, which start done. A section time at
+    t0 is the initial state itself: written here. Returns (lanes, samples (L, S, n), inf where
+    not reached)."""
+    lanes = jax.vmap(lambda pv, y, ts: stepper.init(t0, y, ts, args_of(pv), tols))(lane_args, y0b, ts_all)
+    lanes = eqx.tree_at(lambda s: s.done, lanes, lanes.done | ~live)
+    L, S = ts_all.shape
+    samples = jnp.full((L, S, y0b.shape[-1]), jnp.inf).at[:, 0].set(jnp.where((lanes.k > 0)[:, None], y0b, jnp.inf))
+    return lanes, samples
+
+
+def lane_outputs(stepper: AbstractLaneStepper, lanes: LaneState) -> LaneOutputs:
+    """Per-lane results from the final lane states."""
+    mon = jax.vmap(stepper.monitor)(lanes)
+    return LaneOutputs(
+        y_final=lanes.y,
+        status=jax.vmap(lane_status)(lanes),
+        num_steps=lanes.num_steps,
+        first_invalid_t=mon.first_invalid_t,
+        first_invalid_kind=mon.first_invalid_kind.astype(jnp.int32),
+        min_N=mon.min_N,
+        max_tilt=mon.max_tilt,
+    )
+
+
+class _Slots(NamedTuple):
+    lane: LaneState
+    resumed: Array  # paused once and taken up again (a lane pauses only once)
+    args: tuple[Array, ...]  # the lane-varying args (`split_lane_args`)
+    ts: Array
+
+
+class _Carry(NamedTuple):
+    slots: _Slots
+    lane: Array  # lane index in each slot (L: empty)
+    nxt: Array  # queue position of the next lane not yet started
+    wait: Array  # (L,) paused lanes' predicted remaining cost (-inf: not waiting)
+    lanes: LaneState  # the lane table (a lane is written back when done or paused)
+    resumed: Array  # (L,)
+    samples: Array
+    iters: Array
+    slot_steps: Array
+
+
+def _where_rows(mask: Array, a: Any, b: Any) -> Any:
+    return jax.tree_util.tree_map(
+        lambda x, y: jnp.where(jnp.reshape(mask, mask.shape + (1,) * (x.ndim - 1)), x, y), a, b
+    )
+
+
+def run_pool(
+    stepper: AbstractLaneStepper,
+    lanes: LaneState,
+    samples: Array,
+    lane_args: tuple[Array, ...],
+    args_of: Callable[[Any], Any],
+    ts_all: Array,
+    t0: Array,
+    *,
+    width: int,
+    pause_frac: Array,
+    min_drain_width: int = MIN_DRAIN_WIDTH,
+) -> tuple[LaneState, Array, PoolStats]:
+    """The lanes that are not done yet, in order, through ``width`` slots (refilled as lanes finish).
+
+    ``lanes``, ``samples``: from `start_lanes` (``samples`` (L, S, n) is written in place);
+    ``lane_args``/``args_of``: `split_lane_args`; ``ts_all`` (L, S): section times. A lane
+    pauses at the end of its first step past t0 + ``pause_frac`` (t1 - t0) (inf: never); it
+    stops between two steps, so resuming it continues the very same step sequence. Call inside
+    jit. Returns (final lanes, samples, `PoolStats`)."""
+    L = samples.shape[0]
+    B = min(width, L)
+    # the queue: lanes with work (not padding, not invalid at t0 with stop_on_invalid), in order
+    queue = jnp.argsort(lanes.done, stable=True).astype(jnp.int32)
+    n_queue = jnp.sum(~lanes.done).astype(jnp.int32)
+
+    def _step(slot: _Slots):
+        new, hit = stepper.step(slot.lane, args_of(slot.args), slot.ts)
+        paused = ~new.done & ~slot.resumed & (new.tprev >= t0 + pause_frac * (new.t1 - t0))
+        return slot._replace(lane=new), hit, paused
+
+    step_v = jax.vmap(_step)
+
+    def take(lane, lanes, resumed):
+        j = jnp.minimum(lane, L - 1)
+        return _Slots(
+            jax.tree_util.tree_map(lambda x: x[j], lanes), resumed[j], tuple(x[j] for x in lane_args), ts_all[j]
+        )
+
+    def lane_at(pos):
+        return jnp.where(pos < n_queue, queue[jnp.minimum(pos, L - 1)], L).astype(jnp.int32)
+
+    no = jnp.asarray(-jnp.inf)
+
+    def body(c: _Carry) -> _Carry:
+        slots, lane = c.slots, c.lane
+        active = (lane < L) & ~slots.lane.done
+        stepped, hit, paused = step_v(slots)
+        slots = _where_rows(active, stepped, slots)
+        w = jnp.where(active & hit, lane, L)
+        samples = c.samples.at[w, slots.lane.k - 1].set(slots.lane.y, mode="drop")
+        pause = active & paused
+        fin = (lane < L) & (slots.lane.done | pause)
+
+        def swap(args):
+            # Write finished and paused lanes back; a paused lane waits with its predicted
+            # remaining cost (steps so far x remaining / elapsed time span) as priority.
+            # Free slots take the queue's next lanes, then the waiting lanes, costliest first.
+            slots, lane, nxt, wait, lanes, resumed = args
+            wb = jnp.where(fin, lane, L)
+            slots = slots._replace(resumed=slots.resumed | pause)
+            lanes = jax.tree_util.tree_map(lambda a, s: a.at[wb].set(s, mode="drop"), lanes, slots.lane)
+            resumed = resumed.at[wb].set(slots.resumed, mode="drop")
+            st = slots.lane
+            elapsed = st.tprev - t0
+            cost = st.num_steps * (st.t1 - st.tprev) / jnp.where(elapsed > 0, elapsed, 1.0)
+            wait = wait.at[jnp.where(pause, lane, L)].set(cost.astype(wait.dtype), mode="drop")
+            rank = jnp.cumsum(fin.astype(jnp.int32)) - 1
+            from_queue = nxt + rank < n_queue
+            by_cost = jnp.argsort(-wait)  # waiting lanes first (the others wait at -inf)
+            pick = by_cost[jnp.clip(rank - jnp.maximum(n_queue - nxt, 0), 0, L - 1)]
+            new_lane = jnp.where(from_queue, lane_at(nxt + rank), jnp.where(wait[pick] > no, pick, L))
+            new_lane = jnp.where(fin, new_lane, lane).astype(jnp.int32)
+            refill = fin & (new_lane < L)
+            wait = wait.at[jnp.where(refill & ~from_queue, new_lane, L)].set(no, mode="drop")
+            nxt = nxt + jnp.sum(refill & from_queue).astype(jnp.int32)
+            slots = _where_rows(refill, take(new_lane, lanes, resumed), slots)
+            lane = jnp.where(fin, jnp.where(refill, new_lane, L), lane).astype(jnp.int32)
+            return slots, lane, nxt, wait, lanes, resumed
+
+        slots, lane, nxt, wait, lanes, resumed = jax.lax.cond(
+            jnp.any(fin), swap, lambda a: a, (slots, lane, c.nxt, c.wait, c.lanes, c.resumed)
+        )
+        return _Carry(slots, lane, nxt, wait, lanes, resumed, samples, c.iters + 1, c.slot_steps + lane.shape[0])
+
+    # the drain: widths B, B/2, B/4, ... (see the module docstring)
+    widths = [B]
+    while L > B and widths[-1] // 2 >= min_drain_width:
+        widths.append(widths[-1] // 2)
+    z = jnp.zeros((), jnp.int32)
+    resumed = jnp.zeros_like(lanes.done)
+    lane = lane_at(jnp.arange(B, dtype=jnp.int32))
+    carry = _Carry(
+        slots=take(lane, lanes, resumed),
+        lane=lane,
+        nxt=jnp.minimum(jnp.asarray(B, jnp.int32), n_queue),
+        wait=jnp.full((L,), -jnp.inf),
+        lanes=lanes,
+        resumed=resumed,
+        samples=samples,
+        iters=z,
+        slot_steps=z,
+    )
+    for nxt_w in [*widths[1:], 0]:
+
+        def cond(c: _Carry, nxt_w=nxt_w):
+            work = jnp.sum(c.lane < L) + jnp.maximum(n_queue - c.nxt, 0) + jnp.sum(c.wait > -jnp.inf)
+            return jnp.any(c.lane < L) & (work > nxt_w)
+
+        carry = jax.lax.while_loop(cond, body, carry)
+        if nxt_w:
+            keep = jnp.argsort(carry.lane >= L, stable=True)[:nxt_w]  # the running lanes first
+            carry = carry._replace(
+                slots=jax.tree_util.tree_map(lambda x, keep=keep: x[keep], carry.slots), lane=carry.lane[keep]
+            )
+    stats = PoolStats(iterations=carry.iters, slot_steps=carry.slot_steps, width=B)
+    return carry.lanes, carry.samples, stats

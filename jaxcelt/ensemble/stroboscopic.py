@@ -1,0 +1,297 @@
+"""Stroboscopic lanes: each (parameters, initial state) solved to its section times, many at once.
+
+For a lane with forcing frequency omega_pi the section times are t0 + (transient + k) 2 pi /
+omega_pi, k = 0 .. S-1 (`SweepConfig`); the stepper steps exactly onto them, so the samples are
+solver states. `run_lanes` runs one chunk of lanes: padded and dealt round-robin over the
+devices (`jaxcelt.ensemble.shard`), through the pool (`jaxcelt.ensemble.pool`) in one jitted
+call per device, then the optional Lyapunov stage. Chunking, resumable writing and several
+processes are `jaxcelt.sweep`'s business.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .. import _config  # noqa: F401
+from .._types import Array
+from ..contact import get_contact_law
+from ..diagnostics import centre_position
+from ..lyapunov import celt_lyapunov
+from ..params import PARAM_NAMES, CeltParams
+from ..solve import DEFAULT_SOLVER
+from .pool import DEFAULT_WIDTH, PILOT_FRACTION, PoolStats, lane_outputs, run_pool, split_lane_args, start_lanes
+from .shard import device_mesh, pad_lanes, shard_lanes
+from .stepper import AbstractLaneStepper, erk_tableau, make_stepper
+
+__all__ = ["SweepConfig", "lanes_params", "run_lanes", "run_lanes_with_stats"]
+
+
+@dataclasses.dataclass(frozen=True)
+class SweepConfig:
+    """Static settings of a sweep (everything but the parameter values and initial states)."""
+
+    transient_periods: int = 200
+    sample_periods: int = 100
+    lyapunov_periods: int = 0
+    """periods of tangent dynamics after the transient (0: no Lyapunov exponent)"""
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    max_steps: int = 1_000_000
+    solver: Any = DEFAULT_SOLVER
+    contact_law: Any = None
+    t0: float = 0.0
+    stop_on_invalid: bool = False
+    """end a lane at the first accepted step whose end state is invalid (status 2, later samples inf)"""
+
+    def __post_init__(self):
+        for name in ("transient_periods", "sample_periods", "lyapunov_periods", "max_steps"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < 0:
+                raise ValueError(f"{name!r} must be a non-negative int, got {v!r}")
+        if self.sample_periods < 1:
+            raise ValueError(f"'sample_periods' must be >= 1, got {self.sample_periods}")
+        if self.max_steps < 1:
+            raise ValueError(f"'max_steps' must be >= 1, got {self.max_steps}")
+        for name in ("rtol", "atol"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"{name!r} must be a positive finite number, got {v!r}")
+
+    def attrs(self) -> dict[str, Any]:
+        """Plain-python description (for dataset attributes)."""
+        law = get_contact_law(self.contact_law)
+        return dict(
+            transient_periods=int(self.transient_periods),
+            sample_periods=int(self.sample_periods),
+            lyapunov_periods=int(self.lyapunov_periods),
+            rtol=float(self.rtol),
+            atol=float(self.atol),
+            max_steps=int(self.max_steps),
+            solver=type(self.solver).__name__,
+            step_size_controller="PIDController + ClipStepSizeController(step_ts=section times)",
+            contact_law=f"{type(law).__name__}(rolling_resistance={law.rolling_resistance})",
+            t0=float(self.t0),
+            stop_on_invalid=int(bool(self.stop_on_invalid)),
+        )
+
+
+def lanes_params(params: CeltParams, name: str, values: Array) -> CeltParams:
+    """A batched `CeltParams` with a leading lane axis: field ``name`` = ``values``, others broadcast."""
+    if name not in PARAM_NAMES:
+        raise ValueError(f"unknown parameter {name!r}; known: {PARAM_NAMES}")
+    values = jnp.asarray(values, dtype=jnp.float64)
+    L = values.shape[0]
+    pb = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(jnp.asarray(x), (L,)), params)
+    return eqx.tree_at(lambda p: getattr(p, name), pb, values)
+
+
+def _extras(ys: Array, p: CeltParams) -> dict[str, Array]:
+    """Global motion of O from one lane's samples (S, 13); samples after a stop (inf) ignored."""
+    r_O = jax.vmap(centre_position, in_axes=(0, None))(ys, p)
+    dist = jnp.linalg.norm(r_O[:, :2] - r_O[0:1, :2], axis=-1)
+    fin = jnp.isfinite(dist)
+    last = jnp.max(jnp.where(fin, jnp.arange(dist.shape[0]), -1))
+    drift = jnp.where(last >= 0, dist[jnp.maximum(last, 0)], jnp.nan)
+    exc = jnp.where(last >= 0, jnp.max(jnp.where(fin, dist, -jnp.inf)), jnp.nan)
+    return dict(drift=drift, max_excursion=exc, r_O=r_O)
+
+
+def _erk_tableau(cfg: SweepConfig) -> Any:
+    """`jaxcelt.ensemble.erk_tableau` of the sweep's solver: the fused step's tableau, or None
+    (diffrax's own step)."""
+    return erk_tableau(cfg.solver)
+
+
+def _stepper(cfg: SweepConfig, opaque_true: Array | None = None) -> AbstractLaneStepper:
+    return make_stepper(
+        cfg.solver, cfg.contact_law, rtol=cfg.rtol, atol=cfg.atol, max_steps=cfg.max_steps,
+        stop_on_invalid=cfg.stop_on_invalid, opaque_true=opaque_true,
+    )  # fmt: skip
+
+
+def _section_times(pb: CeltParams, transient: Array, cfg: SweepConfig) -> Array:
+    """(L, S) stroboscopic times t0 + k 2 pi / omega_pi, k = transient, transient + 1, ..."""
+    T = 2 * jnp.pi / pb.omega_pi
+    S = cfg.sample_periods
+    return jnp.asarray(cfg.t0, jnp.float64) + T[:, None] * (transient + jnp.arange(S, dtype=jnp.float64))[None, :]
+
+
+def _lyap_lane(p: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig) -> Array:
+    lr = celt_lyapunov(
+        p,
+        y_start,
+        periods=cfg.lyapunov_periods,
+        t0=t_start,
+        contact_law=cfg.contact_law,
+        solver=cfg.solver,
+        rtol=cfg.rtol,
+        atol=cfg.atol,
+        max_steps=cfg.max_steps,  # per period: a bound, not a cost
+    )
+    return lr.exponent
+
+
+@eqx.filter_jit
+def _pool_chunk(
+    pb: CeltParams,
+    y0b: Array,
+    live: Array,
+    pause_frac: Array,
+    transient: Array,
+    tols: Array,
+    cfg: SweepConfig,
+    width: int,
+    mesh: Any,
+    vary: tuple[bool, ...],
+    opaque_true: Array,
+) -> tuple[dict[str, Array], Array, Array]:
+    """One chunk of lanes through the pool (per device): per-lane outputs and the loop counters.
+
+    ``opaque_true``: a traced True (a jit argument: XLA would fold a constant predicate and the
+    fused step's kernel boundaries would vanish). ``vary``: `jaxcelt.ensemble.split_lane_args`."""
+
+    def run(pb, y0b, live):
+        stepper = _stepper(cfg, opaque_true)
+        pv_all, params_of = split_lane_args(pb, vary)
+        ts_all = _section_times(pb, transient, cfg)
+        t0 = jnp.asarray(cfg.t0, jnp.float64)
+        lanes, samples = start_lanes(stepper, pv_all, params_of, y0b, ts_all, live, tols, t0)
+        lanes, samples, stats = run_pool(
+            stepper, lanes, samples, pv_all, params_of, ts_all, t0, width=width, pause_frac=pause_frac
+        )
+        out = dict(lane_outputs(stepper, lanes).as_dict(), samples=samples, t_samples=ts_all)
+        out.update(jax.vmap(_extras)(samples, pb))
+        return out, stats.iterations[None], stats.slot_steps[None]  # loop counters: one per device
+
+    return shard_lanes(run, mesh, 3)(pb, y0b, live)
+
+
+@eqx.filter_jit
+def _lyap_chunk(pb: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig, mesh: Any) -> Array:
+    run = jax.vmap(lambda p, y, t: _lyap_lane(p, y, t, cfg))
+    return shard_lanes(run, mesh, 3)(pb, y_start, t_start)
+
+
+def run_lanes_with_stats(
+    pb: CeltParams,
+    y0b: Array,
+    cfg: SweepConfig,
+    *,
+    devices: Sequence[Any] | None = None,
+    pad_to: int | None = None,
+    width: int | None = None,
+    compile_only: bool = False,
+    varying: Sequence[str] = (),
+    pilot_fraction: float = PILOT_FRACTION,
+) -> tuple[dict[str, np.ndarray], PoolStats]:
+    """`run_lanes`, with the pool's statistics apart: (per-lane numpy arrays, `PoolStats` over
+    all devices: the busiest device's iterations, the step slots paid by all, the width)."""
+    mesh = device_mesh(devices)
+    L = int(np.shape(y0b)[0])
+    ndev = 1 if mesh is None else mesh.devices.size
+    Lp = math.ceil(max(L, pad_to or 0) / ndev) * ndev
+    pb_np = jax.tree_util.tree_map(lambda x: pad_lanes(np.asarray(x), Lp), pb)
+    y0_np = pad_lanes(np.asarray(y0b, dtype=np.float64), Lp)
+    static_cfg = dataclasses.replace(cfg, transient_periods=0)  # transient is traced: no recompiles
+    transient = jnp.asarray(float(cfg.transient_periods))
+    W = int(width or DEFAULT_WIDTH)
+    if W < 1:
+        raise ValueError(f"width must be >= 1, got {width!r}")
+    nocfg = dataclasses.replace(static_cfg, lyapunov_periods=0)
+    unknown = set(varying) - set(PARAM_NAMES)
+    if unknown:
+        raise ValueError(f"varying: unknown parameter name(s) {sorted(unknown)}")
+    path_leaves = jax.tree_util.tree_flatten_with_path(pb_np)[0]
+    vary = tuple(bool(path[-1].name in varying or np.any(x != x[:1])) for path, x in path_leaves)
+    Lloc = Lp // ndev
+    Wd = min(W, Lloc)
+    # position i of the sharded arrays holds lane pos_lane[i]; device d holds positions
+    # d Lloc ... (d + 1) Lloc - 1 and gets lanes d, d + ndev, ... (a mix of cheap and costly)
+    pos_lane = np.arange(Lp).reshape(-1, ndev).T.reshape(-1)
+    pb_p = jax.tree_util.tree_map(lambda x: x[pos_lane], pb_np)
+    live = (pos_lane < L) & (not compile_only)
+    tols = jnp.asarray([cfg.rtol, cfg.atol])
+    # the pilot pause only pays where lanes queue for slots
+    frac = float(pilot_fraction) if pilot_fraction and Lloc > Wd else np.inf
+    out, iters, slot_steps = _pool_chunk(
+        pb_p, y0_np[pos_lane], live, jnp.asarray(frac), transient, tols, nocfg, Wd, mesh, vary, jnp.asarray(True)
+    )
+    stats = PoolStats(iterations=int(np.asarray(iters).max()), slot_steps=int(np.sum(np.asarray(slot_steps))), width=Wd)
+    out = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(out))
+    inv = np.empty_like(pos_lane)
+    inv[pos_lane] = np.arange(Lp)
+    out = {k: v[inv][:L] for k, v in out.items()}
+    out["valid"] = out["first_invalid_kind"] == 0
+    out["lyapunov"] = np.full(L, np.nan)
+    if cfg.lyapunov_periods > 0 and not compile_only:
+        ok = np.flatnonzero(out["status"] == 0)
+        ok = ok[np.argsort(-out["num_steps"][ok], kind="stable")]  # similar cost side by side
+        G = W * ndev
+        for i in range(0, len(ok), G):
+            idx = pad_lanes(ok[i : i + G], G)
+            lam = _lyap_chunk(
+                jax.tree_util.tree_map(lambda x, idx=idx: x[idx], pb_np),
+                out["samples"][idx, 0],
+                out["t_samples"][idx, 0],
+                static_cfg,
+                mesh,
+            )
+            n = min(G, len(ok) - i)
+            out["lyapunov"][idx[:n]] = np.asarray(lam)[:n]
+    return out, stats
+
+
+def run_lanes(
+    pb: CeltParams,
+    y0b: Array,
+    cfg: SweepConfig,
+    *,
+    devices: Sequence[Any] | None = None,
+    pad_to: int | None = None,
+    width: int | None = None,
+    compile_only: bool = False,
+    varying: Sequence[str] = (),
+    pilot_fraction: float = PILOT_FRACTION,
+) -> dict[str, np.ndarray]:
+    """Run one chunk of lanes (batched params and y0 with a leading lane axis) and return numpy arrays.
+
+    ``width`` batch slots per device (default `DEFAULT_WIDTH`) step in one jitted while loop
+    (`jaxcelt.ensemble.run_pool`); a slot whose lane finishes is refilled with the next lane at
+    once, so no slot idles until the slowest lane is done (only the final drain does).
+    ``pilot_fraction`` (default `PILOT_FRACTION`; 0 = off; only used when a device has more
+    lanes than slots): each lane pauses once after this fraction of its time span and is taken
+    up again costliest-predicted first. The Lyapunov stage (``cfg.lyapunov_periods > 0``) then
+    runs vmapped over the successful lanes in groups of ``width`` ordered by the measured
+    main-solve step count (a cost estimate that needs no pilot run).
+
+    Sharded over ``devices`` (default all local devices; lanes are dealt round-robin); padded
+    to ``pad_to`` lanes (so a short last chunk reuses the compiled shape) and to a multiple
+    of the device count. Padding lanes are dropped; in the pool they finish at once.
+    ``compile_only=True``: every lane marked as padding -- compiles the kernel for these
+    shapes and returns at once (used to time compilation apart from running).
+    ``varying``: names of parameters to treat as differing between lanes even where this
+    chunk's lanes happen to share a value (parameters that do differ are always detected),
+    so that all chunks of a sweep compile to one kernel; the others are constants of the
+    pool's step.
+
+    Returns the fields of `jaxcelt.sweep.SweepResult` but ``values`` (lane axis first), and the pool's
+    statistics copied into every lane: ``pool_iterations``, ``pool_slot_steps``,
+    ``pool_width`` (`run_lanes_with_stats` returns them apart, as `PoolStats`).
+    """
+    out, stats = run_lanes_with_stats(
+        pb, y0b, cfg, devices=devices, pad_to=pad_to, width=width, compile_only=compile_only, varying=varying,
+        pilot_fraction=pilot_fraction,
+    )  # fmt: skip
+    L = len(out["status"])
+    out["pool_iterations"] = np.full(L, stats.iterations)  # the busiest device's loop iterations
+    out["pool_slot_steps"] = np.full(L, stats.slot_steps)  # step slots paid, over all devices and widths
+    out["pool_width"] = np.full(L, stats.width)
+    return out

@@ -1,0 +1,86 @@
+"""The lane engine's own interface (`jaxcelt.ensemble`): the fused Runge-Kutta stepper against
+diffrax's own step in the same pool, and the pool's statistics against what the schedule implies."""
+
+import diffrax
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+from _sweep_common import KW, VALUES, assert_same_lanes
+
+import jaxcelt as jc
+from jaxcelt.ensemble import (
+    DiffraxStepper,
+    FusedERKStepper,
+    LaneState,
+    lane_outputs,
+    lanes_params,
+    make_stepper,
+    run_pool,
+    split_lane_args,
+    start_lanes,
+)
+
+
+def _pool(params, kind, width):
+    """The pool over the lanes of the shared sweep settings (VALUES, KW) with the given stepper."""
+    pb = lanes_params(params, "omega_pi", VALUES)
+    L = len(VALUES)
+    y0 = jnp.tile(jnp.asarray(jc.initial_state(params)), (L, 1))
+    T = 2 * np.pi / VALUES
+    ts = jnp.asarray(T[:, None] * (KW["transient_periods"] + np.arange(KW["sample_periods"]))[None])
+    vary = tuple(bool(np.any(np.asarray(x) != np.asarray(x)[:1])) for x in jax.tree_util.tree_leaves(pb))
+    opts = dict(rtol=KW["rtol"], atol=KW["atol"], max_steps=KW["max_steps"], stop_on_invalid=False)
+
+    @jax.jit
+    def run(pb, y0, ts, tols, opaque_true):
+        stepper = make_stepper(diffrax.Tsit5(), None, opaque_true=opaque_true, **opts)
+        assert isinstance(stepper, FusedERKStepper)
+        if kind == "diffrax":  # diffrax's own Tsit5 step, as `simulate` takes it
+            stepper = DiffraxStepper(
+                solver=stepper.solver, term=stepper.term, max_steps=opts["max_steps"], stop_on_invalid=False
+            )
+        pv, args_of = split_lane_args(pb, vary)
+        t0 = jnp.asarray(0.0)
+        lanes, samples = start_lanes(stepper, pv, args_of, y0, ts, jnp.ones(L, bool), tols, t0)
+        assert isinstance(lanes, LaneState)
+        lanes, samples, stats = run_pool(
+            stepper, lanes, samples, pv, args_of, ts, t0, width=width, pause_frac=jnp.asarray(jnp.inf)
+        )
+        return lane_outputs(stepper, lanes), samples, stats
+
+    out, samples, stats = run(pb, y0, ts, jnp.asarray([KW["rtol"], KW["atol"]]), jnp.asarray(True))
+    lanes = {k: np.asarray(v) for k, v in out.as_dict().items()}
+    lanes["samples"] = np.asarray(samples)
+    return lanes, stats
+
+
+@pytest.fixture(scope="module")
+def fused(paper_params):
+    return _pool(paper_params, "fused", width=len(VALUES))
+
+
+@pytest.mark.slow  # a second pool compile (~1 min on 2 busy cores); the fused step against `simulate`: test_sweep
+def test_fused_stepper_equals_diffrax_stepper(fused, paper_params):
+    # Same method (Tsit5), controller, first step and section clipping; the fused step sums the
+    # stages in another order than diffrax's generic Runge-Kutta step. So: the same step counts
+    # and statuses, samples within SAMPLE_ATOL (1e-10, as for the pool against `simulate`; see
+    # _sweep_common), min N to rtol 1e-7 (N is a stiff function of the state, test_sweep).
+    ref, _ = _pool(paper_params, "diffrax", width=len(VALUES))
+    got, _ = fused
+    assert_same_lanes(got, ref, keys=("samples", "num_steps", "status", "first_invalid_kind", "y_final"))
+    np.testing.assert_allclose(got["min_N"], ref["min_N"], rtol=1e-7)
+    # max tilt: the fused step keeps min n3 and takes arccos once, diffrax's monitor takes the max
+    # of arccos(n3); arccos amplifies an n3 difference by 1/sin(tilt) (~25 at 0.04 rad), so rtol 1e-7
+    np.testing.assert_allclose(got["max_tilt"], ref["max_tilt"], rtol=1e-7)
+
+
+def test_pool_stats_follow_the_schedule(fused):
+    # With a slot for every lane there is no queue, no pause and no drain: the loop runs until the
+    # slowest lane is done, one step per lane and iteration, and pays every slot each iteration.
+    lanes, stats = fused
+    assert np.all(lanes["status"] == 0)
+    assert stats.width == len(VALUES)
+    assert int(stats.iterations) == int(lanes["num_steps"].max())
+    assert int(stats.slot_steps) == int(stats.iterations) * stats.width
+    assert int(stats.slot_steps) >= int(lanes["num_steps"].sum())

@@ -1,0 +1,116 @@
+"""The diffrax/equinox internals behind `jaxcelt._diffrax_adapter`: the installed versions are the
+pinned ones, the names still exist, and the adapted loop takes diffeqsolve's steps.
+
+If a diffrax or equinox release breaks one of these, the lane pool (`jaxcelt.ensemble`) would no
+longer take `jaxcelt.simulate`'s steps: these tests name the cause before the sweep tests fail."""
+
+import importlib.metadata
+import tomllib
+from pathlib import Path
+
+import diffrax
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+from packaging.requirements import Requirement
+
+from jaxcelt import _diffrax_adapter as ad
+
+
+def _pinned() -> dict[str, Requirement]:
+    deps = tomllib.loads((Path(__file__).parents[1] / "pyproject.toml").read_text())["project"]["dependencies"]
+    return {r.name: r for r in map(Requirement, deps)}
+
+
+@pytest.mark.parametrize("package", ["diffrax", "equinox"])
+def test_installed_versions_are_the_pinned_ones(package):
+    req = _pinned()[package]
+    # an upper bound is what makes the pin a pin: without one a new release is accepted unchecked
+    assert any(s.operator == "<" for s in req.specifier), f"{package}: no upper bound in pyproject.toml ({req})"
+    installed = importlib.metadata.version(package)
+    assert req.specifier.contains(installed, prereleases=True), f"{package} {installed} is outside {req.specifier}"
+
+
+def test_adapted_names_exist():
+    from diffrax._root_finder import use_stepsize_tol
+    from diffrax._term import WrapTerm
+
+    assert ad.use_stepsize_tol is use_stepsize_tol
+    assert isinstance(ad.wrap_term(diffrax.ODETerm(lambda t, y, a: -y)), WrapTerm)
+
+
+def test_clip_helpers_match_diffrax():
+    # t1_clip_floor: 100 ULP below t1, counted independently with numpy's nextafter
+    for t1 in (1.0, 3.7, 1234.5):
+        want = t1
+        for _ in range(100):
+            want = np.nextafter(want, -np.inf)
+        assert float(ad.t1_clip_floor(jnp.asarray(t1))) == want
+    # clip_to_end against diffrax's own (private) function, on both sides of the floor
+    from diffrax._integrate import _clip_to_end
+
+    t1 = jnp.asarray(2.0)
+    floor = ad.t1_clip_floor(t1)
+    for tprev, tnext in ((1.0, 1.5), (1.0, float(floor) + 1e-15), (1.9, 2.5)):
+        for keep in (True, False):
+            args = (jnp.asarray(tprev), jnp.asarray(tnext))
+            _, got = ad.clip_to_end(*args, t1, floor, jnp.asarray(keep))
+            want = _clip_to_end(jnp.minimum(args[0], t1), args[1], t1, floor, jnp.asarray(keep))
+            assert float(got) == float(want), (tprev, tnext, keep)
+
+
+def _forced_oscillator(t, y, args):
+    return jnp.stack([y[1], -args * y[0] - 0.3 * y[1] + jnp.sin(2.0 * t)])
+
+
+@pytest.mark.parametrize("solver", [diffrax.Tsit5(), diffrax.Dopri8(), diffrax.Heun()], ids=lambda s: type(s).__name__)
+@pytest.mark.parametrize("step_ts", [False, True], ids=["pid", "pid+step_ts"])
+def test_adapted_loop_takes_diffeqsolve_steps(solver, step_ts):
+    # loop_init + loop_step repeated until t1 against diffeqsolve(SaveAt(steps=True)): the same
+    # number of attempted and accepted steps, and the same accepted step times and states.
+    # Tolerance 1e-13: the same operations in the same order, but compiled inside another program
+    # (XLA may fuse and reassociate differently), so rounding, not bitwise, is what is promised.
+    t0, t1, y0, k = 0.0, 6.0, jnp.array([1.0, 0.0]), jnp.asarray(4.0)
+    term = diffrax.ODETerm(_forced_oscillator)
+    ts = jnp.linspace(0.5, t1, 12)
+    tol = 1e-3 if isinstance(solver, diffrax.Heun) else 1e-7  # Heun: 2nd order, 1st-order error estimate
+    pid = diffrax.PIDController(rtol=tol, atol=tol / 100)
+    ctrl = diffrax.ClipStepSizeController(pid, step_ts=ts) if step_ts else pid
+    max_steps = 1000
+    sol = diffrax.diffeqsolve(
+        term, solver, t0, t1, None, y0, args=k, stepsize_controller=ctrl,
+        saveat=diffrax.SaveAt(steps=True), max_steps=max_steps,
+    )  # fmt: skip
+    n_acc = int(sol.stats["num_accepted_steps"])
+    assert sol.result == diffrax.RESULTS.successful and n_acc > 10  # several steps, rejections likely
+
+    @jax.jit
+    def adapted():
+        wterm = ad.wrap_term(term)
+        t0_, t1_ = jnp.asarray(t0), jnp.asarray(t1)
+        tnext, cstate, sstate = ad.loop_init(solver, wterm, ctrl, t0_, t1_, y0, k)
+        floor = ad.t1_clip_floor(t1_)
+        out_t = jnp.full(max_steps, jnp.inf)
+        out_y = jnp.full((max_steps, 2), jnp.inf)
+
+        def body(c):
+            tprev, tnext, y, sstate, cstate, n, n_acc, out_t, out_y = c
+            keep, y1, tprev, tnext, sstate1, cstate, _, _ = ad.loop_step(
+                solver, wterm, ctrl, t1_, floor, tprev, tnext, y, k, sstate, cstate
+            )
+            y = jnp.where(keep, y1, y)
+            sstate = jax.tree_util.tree_map(lambda a, b: jnp.where(keep, a, b), sstate1, sstate)
+            out_t = jnp.where(keep, out_t.at[n_acc].set(tprev), out_t)
+            out_y = jnp.where(keep, out_y.at[n_acc].set(y), out_y)
+            return tprev, tnext, y, sstate, cstate, n + 1, n_acc + keep.astype(int), out_t, out_y
+
+        c = (t0_, tnext, y0, sstate, cstate, 0, 0, out_t, out_y)
+        c = jax.lax.while_loop(lambda c: (c[0] < t1_) & (c[5] < max_steps), body, c)
+        return c[5], c[6], c[7], c[8]
+
+    n, n_acc_ad, got_t, got_y = adapted()
+    assert int(n) == int(sol.stats["num_steps"]) and int(n_acc_ad) == n_acc
+    np.testing.assert_allclose(np.asarray(got_t[:n_acc]), np.asarray(sol.ts[:n_acc]), rtol=1e-13, atol=0)
+    np.testing.assert_allclose(np.asarray(got_y[:n_acc]), np.asarray(sol.ys[:n_acc]), rtol=0, atol=1e-13)
+    assert float(got_t[n_acc - 1]) == t1  # the last accepted step ends on t1 exactly (clip_to_end)
