@@ -198,7 +198,8 @@ def _broadcast_y0(params: CeltParams, y0: Any, n_values: int) -> np.ndarray:
 
 
 def _sweep_config(
-    transient_periods, sample_periods, lyapunov_periods, rtol, atol, max_steps, solver, contact_law, t0, stop_on_invalid
+    transient_periods, sample_periods, lyapunov_periods, rtol, atol, max_steps, solver, contact_law, t0, stop_on_invalid,
+    dtype="float64",
 ) -> SweepConfig:
     return SweepConfig(
         transient_periods=int(transient_periods),
@@ -211,7 +212,18 @@ def _sweep_config(
         contact_law=contact_law,
         t0=float(t0),
         stop_on_invalid=bool(stop_on_invalid),
+        dtype=_dtype_name(dtype),
     )
+
+
+def _dtype_name(dtype: Any) -> str:
+    try:
+        name = np.dtype(dtype).name
+    except TypeError:
+        name = None
+    if name not in ("float64", "float32"):
+        raise ValueError(f"dtype must be float64 or float32, got {dtype!r}")
+    return name
 
 
 def _run_chunked(
@@ -320,6 +332,7 @@ def sweep(
     chunk_size: int | None = None,
     sort_by_cost: bool = False,
     stop_on_invalid: bool = False,
+    dtype: Any = "float64",
     width: int | None = None,
     devices: Sequence[Any] | None = None,
     out: str | None = None,
@@ -346,6 +359,9 @@ def sweep(
         stop_on_invalid: end each lane at its first invalid state (lift-off, n3 <= 0):
             status 2, samples after the stop inf, no Lyapunov exponent. Default False (the
             model is integrated on, validity reported), as in `jaxcelt.simulate`.
+        dtype: the pool's arithmetic, ``"float64"`` (default) or ``"float32"`` (faster on GPUs;
+            use rtol >= 1e-6; results come back as float64 arrays, the Lyapunov stage runs
+            in float64). Part of the dataset's fingerprint.
         width: batch slots per device of the pool (default `DEFAULT_WIDTH`).
         devices: devices to shard each chunk over (default all local devices).
         out: directory; write the dataset chunk by chunk there and resume a previous,
@@ -360,7 +376,7 @@ def sweep(
     """
     cfg = _sweep_config(
         transient_periods, sample_periods, lyapunov_periods, rtol, atol, max_steps, solver, contact_law, t0,
-        stop_on_invalid,
+        stop_on_invalid, dtype,
     )  # fmt: skip
     values = np.atleast_1d(np.asarray(values, dtype=np.float64))
     if values.ndim != 1 or values.size == 0:
@@ -470,6 +486,7 @@ def parameter_map(
     chunk_size: int | None = None,
     sort_by_cost: bool = False,
     stop_on_invalid: bool = False,
+    dtype: Any = "float64",
     width: int | None = None,
     devices: Sequence[Any] | None = None,
     out: str | None = None,
@@ -500,7 +517,7 @@ def parameter_map(
     """
     cfg = _sweep_config(
         transient_periods, sample_periods, lyapunov_periods, rtol, atol, max_steps, solver, contact_law, t0,
-        stop_on_invalid,
+        stop_on_invalid, dtype,
     )  # fmt: skip
     for arg, spec in (("x", x), ("y", y)):
         if not (isinstance(spec, tuple | list) and len(spec) == 2 and isinstance(spec[0], str)):

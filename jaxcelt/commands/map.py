@@ -41,6 +41,8 @@ def register(sub) -> None:
     p.add_argument("--rtol", type=positive_float, default=1e-8)
     p.add_argument("--atol", type=positive_float, default=1e-10)
     p.add_argument("--max-steps", type=positive_int, default=1_000_000)
+    p.add_argument("--dtype", default="float64", choices=("float64", "float32"),
+                   help="the pool's arithmetic (float32: faster on GPUs; use --rtol >= 1e-6)")  # fmt: skip
     p.add_argument(
         "--chunk-size", type=positive_int, default=600, help="lanes per jitted pool launch (unit of resumable writing)"
     )
@@ -126,7 +128,8 @@ def run(args) -> int:
             params, x=x, y=y, y0=y0, transient_periods=args.transient, sample_periods=args.sample,
             lyapunov_periods=args.lyapunov, solver=make_solver(args.solver), rtol=args.rtol, atol=args.atol,
             max_steps=args.max_steps, chunk_size=args.chunk_size, width=args.width,
-            stop_on_invalid=args.stop_on_invalid, sort_by_cost=True, out=str(args.out), progress=True,
+            stop_on_invalid=args.stop_on_invalid, dtype=args.dtype, sort_by_cost=True, out=str(args.out),
+            progress=True,
         )  # fmt: skip
     wall = time.perf_counter() - t0
     summary = {
@@ -135,6 +138,7 @@ def run(args) -> int:
         "y": {"name": y[0], "from": float(y[1][0]), "to": float(y[1][-1]), "n": int(y[1].size)},
         "set": args.set,
         **run_settings(args, wall),
+        "dtype": args.dtype,
         "load_average_at_start": None if load is None else [round(v, 2) for v in load],
         **summarize(ds),
     }

@@ -109,7 +109,7 @@ def start_lanes(
     lanes = jax.vmap(lambda pv, y, ts: stepper.init(t0, y, ts, args_of(pv), tols))(lane_args, y0b, ts_all)
     lanes = eqx.tree_at(lambda s: s.done, lanes, lanes.done | ~live)
     L, S = ts_all.shape
-    samples = jnp.full((L, S, y0b.shape[-1]), jnp.inf).at[:, 0].set(jnp.where((lanes.k > 0)[:, None], y0b, jnp.inf))
+    samples = jnp.full((L, S, y0b.shape[-1]), jnp.inf, y0b.dtype).at[:, 0].set(jnp.where((lanes.k > 0)[:, None], y0b, jnp.inf))
     return lanes, samples
 
 

@@ -181,7 +181,7 @@ class DiffraxStepper(AbstractLaneStepper):
 def _combine(y0: Array, coeffs: Any, ks: list[Array]) -> Array:
     """y0 + sum_j coeffs[j] ks[j] over the non-zero coefficients (tableau constants)."""
     out = y0
-    for a, k in zip(np.asarray(coeffs, dtype=float), ks):
+    for a, k in zip(np.asarray(coeffs, dtype=float).tolist(), ks):  # python floats: weakly typed (float32 lanes)
         if a != 0.0:
             out = out + a * k
     return out
@@ -250,7 +250,7 @@ class FusedERKStepper(AbstractLaneStepper):
         t1, y0, t0 = lane.t1, lane.y, lane.tprev
         dt = lane.tnext - t0
         ks = [st.f * dt]
-        for c, a in zip(np.asarray(tab.c, dtype=float), tab.a_lower):
+        for c, a in zip(np.asarray(tab.c, dtype=float).tolist(), tab.a_lower):
             yi = boundary(_combine(y0, a, ks))
             fi, aux = vector_field_and_normal(t0 + c * dt, yi, p, self.law)
             ks.append(fi * dt)

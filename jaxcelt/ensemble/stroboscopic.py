@@ -50,8 +50,12 @@ class SweepConfig:
     t0: float = 0.0
     stop_on_invalid: bool = False
     """end a lane at the first accepted step whose end state is invalid (status 2, later samples inf)"""
+    dtype: str = "float64"
+    """"float64" (default) or "float32": the pool's arithmetic (the Lyapunov stage stays float64)"""
 
     def __post_init__(self):
+        if self.dtype not in ("float64", "float32"):
+            raise ValueError(f"'dtype' must be 'float64' or 'float32', got {self.dtype!r}")
         for name in ("transient_periods", "sample_periods", "lyapunov_periods", "max_steps"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < 0:
@@ -80,6 +84,7 @@ class SweepConfig:
             contact_law=f"{type(law).__name__}(rolling_resistance={law.rolling_resistance})",
             t0=float(self.t0),
             stop_on_invalid=int(bool(self.stop_on_invalid)),
+            dtype=str(self.dtype),
         )
 
 
@@ -119,9 +124,10 @@ def _stepper(cfg: SweepConfig, opaque_true: Array | None = None) -> AbstractLane
 
 def _section_times(pb: CeltParams, transient: Array, cfg: SweepConfig) -> Array:
     """(L, S) stroboscopic times t0 + k 2 pi / omega_pi, k = transient, transient + 1, ..."""
+    dt = pb.omega_pi.dtype
     T = 2 * jnp.pi / pb.omega_pi
     S = cfg.sample_periods
-    return jnp.asarray(cfg.t0, jnp.float64) + T[:, None] * (transient + jnp.arange(S, dtype=jnp.float64))[None, :]
+    return jnp.asarray(cfg.t0, dt) + T[:, None] * (transient.astype(dt) + jnp.arange(S, dtype=dt))[None, :]
 
 
 def _lyap_lane(p: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig) -> Array:
@@ -162,7 +168,7 @@ def _pool_chunk(
         stepper = _stepper(cfg, opaque_true)
         pv_all, params_of = split_lane_args(pb, vary)
         ts_all = _section_times(pb, transient, cfg)
-        t0 = jnp.asarray(cfg.t0, jnp.float64)
+        t0 = jnp.asarray(cfg.t0, cfg.dtype)
         lanes, samples = start_lanes(stepper, pv_all, params_of, y0b, ts_all, live, tols, t0)
         lanes, samples, stats = run_pool(
             stepper, lanes, samples, pv_all, params_of, ts_all, t0, width=width, pause_frac=pause_frac
@@ -200,6 +206,7 @@ def run_lanes_with_stats(
     Lp = math.ceil(max(L, pad_to or 0) / ndev) * ndev
     pb_np = jax.tree_util.tree_map(lambda x: pad_lanes(np.asarray(x), Lp), pb)
     y0_np = pad_lanes(np.asarray(y0b, dtype=np.float64), Lp)
+    dt = np.dtype(cfg.dtype)  # the pool's arithmetic; the Lyapunov stage below stays float64
     static_cfg = dataclasses.replace(cfg, transient_periods=0)  # transient is traced: no recompiles
     transient = jnp.asarray(float(cfg.transient_periods))
     W = int(width or DEFAULT_WIDTH)
@@ -216,19 +223,21 @@ def run_lanes_with_stats(
     # position i of the sharded arrays holds lane pos_lane[i]; device d holds positions
     # d Lloc ... (d + 1) Lloc - 1 and gets lanes d, d + ndev, ... (a mix of cheap and costly)
     pos_lane = np.arange(Lp).reshape(-1, ndev).T.reshape(-1)
-    pb_p = jax.tree_util.tree_map(lambda x: x[pos_lane], pb_np)
+    pb_p = jax.tree_util.tree_map(lambda x: x[pos_lane].astype(dt), pb_np)
     live = (pos_lane < L) & (not compile_only)
-    tols = jnp.asarray([cfg.rtol, cfg.atol])
+    tols = jnp.asarray([cfg.rtol, cfg.atol], dt)
     # the pilot pause only pays where lanes queue for slots
     frac = float(pilot_fraction) if pilot_fraction and Lloc > Wd else np.inf
     out, iters, slot_steps = _pool_chunk(
-        pb_p, y0_np[pos_lane], live, jnp.asarray(frac), transient, tols, nocfg, Wd, mesh, vary, jnp.asarray(True)
+        pb_p, y0_np[pos_lane].astype(dt), live, jnp.asarray(frac), transient, tols, nocfg, Wd, mesh, vary, jnp.asarray(True)
     )
     stats = PoolStats(iterations=int(np.asarray(iters).max()), slot_steps=int(np.sum(np.asarray(slot_steps))), width=Wd)
     out = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(out))
     inv = np.empty_like(pos_lane)
     inv[pos_lane] = np.arange(Lp)
     out = {k: v[inv][:L] for k, v in out.items()}
+    # a float32 pool's results in float64 arrays, as a float64 run's
+    out = {k: v.astype(np.float64) if v.dtype == np.float32 else v for k, v in out.items()}
     out["valid"] = out["first_invalid_kind"] == 0
     out["lyapunov"] = np.full(L, np.nan)
     if cfg.lyapunov_periods > 0 and not compile_only:
@@ -239,7 +248,7 @@ def run_lanes_with_stats(
             idx = pad_lanes(ok[i : i + G], G)
             lam = _lyap_chunk(
                 jax.tree_util.tree_map(lambda x, idx=idx: x[idx], pb_np),
-                out["samples"][idx, 0],
+                out["samples"][idx, 0],  # float64 (a float32 pool's samples cast up)
                 out["t_samples"][idx, 0],
                 static_cfg,
                 mesh,

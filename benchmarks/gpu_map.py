@@ -1,0 +1,141 @@
+"""Benchmark: an omega_pi x q_pi regime map on whatever device JAX sees (made for one GPU).
+
+One `jaxcelt.parameter_map` of NX x NY lanes from rest, TRANSIENT + SAMPLE forcing periods,
+stop-on-invalid (as ``jaxcelt map``), no Lyapunov stage. Compilation is timed apart: the pool's
+kernel is compiled first for the very shapes of the map (``run_lanes(..., compile_only=True)``),
+then the map runs on the compiled kernel. Appends one JSON record per run (versions, device,
+dtype, tolerances, compile and run seconds, lanes/s, step counts, regime counts) to ``--json``
+and saves the regime labels (``--labels``, .npz) so that float32 and float64 maps can be compared
+cell by cell.
+
+    python benchmarks/gpu_map.py --nx 400 --ny 400 --dtype float64 --json out/gpu_map.json
+    python benchmarks/gpu_map.py --nx 400 --ny 400 --dtype float32 --rtol 1e-6 --atol 1e-8 ...
+    python benchmarks/gpu_map.py --compare out/labels_float64_400x400.npz out/labels_float32_400x400.npz
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+def compare(a: Path, b: Path) -> dict:
+    A, B = np.load(a), np.load(b)
+    same = A["category"] == B["category"]
+    out = {
+        "maps": [str(a), str(b)],
+        "cells": int(same.size),
+        "same_category_fraction": round(float(same.mean()), 4),
+        "same_status_fraction": round(float((A["status"] == B["status"]).mean()), 4),
+    }
+    print(json.dumps(out))
+    return out
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--nx", type=int, default=400, help="omega_pi values (10 .. 20 rad/s)")
+    ap.add_argument("--ny", type=int, default=400, help="q_pi values (0.02 .. 0.06 m)")
+    ap.add_argument("--transient", type=int, default=270)
+    ap.add_argument("--sample", type=int, default=30)
+    ap.add_argument("--dtype", default="float64", choices=("float64", "float32"))
+    ap.add_argument("--rtol", type=float, default=1e-8)
+    ap.add_argument("--atol", type=float, default=1e-10)
+    ap.add_argument("--chunk", type=int, default=None, help="lanes per pool launch (default: all)")
+    ap.add_argument("--width", type=int, default=None, help="pool slots (default: the chunk, no queue)")
+    ap.add_argument("--json", type=Path, default=Path("out/gpu_map.json"), help="JSON list to append a record to")
+    ap.add_argument("--labels", type=Path, default=None, help=".npz of the map's categories and status")
+    ap.add_argument("--compare", nargs=2, type=Path, default=None, help="compare two --labels files and exit")
+    a = ap.parse_args()
+    if a.compare:
+        rec = compare(*a.compare)
+        _append(a.json, {"comparison": rec})
+        return 0
+
+    import jax
+
+    import jaxcelt as jc
+    from jaxcelt.ensemble import lanes_params, run_lanes
+    from jaxcelt.plotting.map import map_categories
+    from jaxcelt.sweep import SweepConfig
+    from jaxcelt.versions import versions
+
+    ver = versions()
+    print(json.dumps(ver), flush=True)
+    p = jc.CeltParams.paper()
+    xs = np.linspace(10.0, 20.0, a.nx)
+    ys = np.linspace(0.02, 0.06, a.ny)
+    L = a.nx * a.ny
+    cs = min(a.chunk or L, L)
+    W = a.width or cs
+    kw = dict(
+        transient_periods=a.transient, sample_periods=a.sample, rtol=a.rtol, atol=a.atol, stop_on_invalid=True,
+        dtype=a.dtype,
+    )  # fmt: skip
+    # compile for the map's own shapes: chunk 0's lanes, padded to the chunk size, all marked padding
+    lane_x = np.repeat(xs, a.ny)[:cs]
+    lane_y = np.tile(ys, a.nx)[:cs]
+    import equinox as eqx
+    import jax.numpy as jnp
+
+    pb = eqx.tree_at(lambda q: q.q_pi, lanes_params(p, "omega_pi", lane_x), jnp.asarray(lane_y))
+    y0 = np.tile(np.asarray(jc.initial_state(p)), (cs, 1))
+    cfg = SweepConfig(**kw)
+    t = time.perf_counter()
+    run_lanes(pb, y0, cfg, pad_to=cs, width=W, compile_only=True, varying=("omega_pi", "q_pi"))
+    t_compile = time.perf_counter() - t
+    print(f"compile {t_compile:.1f} s", flush=True)
+    t = time.perf_counter()
+    ds = jc.parameter_map(p, x=("omega_pi", xs), y=("q_pi", ys), chunk_size=cs, width=W, **kw)
+    t_run = time.perf_counter() - t
+    steps = ds["num_steps"].values
+    status = ds["status"].values
+    cat, cats = map_categories(ds["regime"].values, ds["period"].values)
+    rec = {
+        "versions": ver,
+        "device": str(jax.devices()[0]),
+        "device_kind": jax.devices()[0].device_kind,
+        "grid": [a.nx, a.ny],
+        "lanes": L,
+        "periods": a.transient + a.sample,
+        "transient_periods": a.transient,
+        "sample_periods": a.sample,
+        "dtype": a.dtype,
+        "rtol": a.rtol,
+        "atol": a.atol,
+        "chunk": cs,
+        "width": W,
+        "compile_s": round(t_compile, 2),
+        "run_s": round(t_run, 2),
+        "lanes_per_s": round(L / t_run, 1),
+        "steps_total": int(steps.sum()),
+        "steps_max": int(steps.max()),
+        "steps_median": float(np.median(steps)),
+        "status_counts": {str(k): int(v) for k, v in zip(*np.unique(status, return_counts=True))},
+        "regime_counts": {label: int(np.sum(cat == i)) for i, (label, _) in enumerate(cats) if np.any(cat == i)},
+    }
+    print(json.dumps(rec), flush=True)
+    _append(a.json, rec)
+    if a.labels:
+        a.labels.parent.mkdir(parents=True, exist_ok=True)
+        np.savez_compressed(a.labels, category=cat, status=status, omega_pi=xs, q_pi=ys)
+    return 0
+
+
+def _append(path: Path, rec: dict) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    recs = json.loads(path.read_text()) if path.exists() else []
+    recs.append(rec)
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text(json.dumps(recs, indent=1) + "\n")
+    os.replace(tmp, path)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
