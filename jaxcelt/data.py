@@ -64,6 +64,8 @@ __all__ = [
     "save_csv",
     "load_csv",
     "CSV_COLUMNS",
+    "SENSOR_KINDS",
+    "rotation_matrix",
 ]
 
 FORMAT = "jaxcelt-measured-data"
@@ -73,6 +75,25 @@ OBSERVABLES: dict[str, int] = {"state": 13, "omega": 3, "orientation": 4, "centr
 """Observation kind -> number of channels: the state; omega (a gyro in body axes) [rad/s];
 orientation (n, psi); centre (the geometric centre O, global) [m]; accel (an accelerometer at the
 mass centre C in body axes: the specific force a - g, what an IMU measures) [m/s^2]."""
+
+
+SENSOR_KINDS = ("omega", "accel")
+"""Observation kinds an IMU measures in its own axes (rotated by the sensor-to-body rotation)."""
+
+
+def rotation_matrix(rotvec: ArrayLike) -> Array:
+    """Rotation matrix exp([r]x) of a rotation vector r (3,) [rad] (Rodrigues); differentiable at 0.
+
+    As the sensor rotation of `jaxcelt.fit.fit`: a vector with body components h has sensor
+    components R h."""
+    r = jnp.asarray(rotvec, dtype=float)
+    th2 = jnp.dot(r, r)
+    small = th2 < 1e-12
+    th = jnp.sqrt(jnp.where(small, 1.0, th2))
+    a = jnp.where(small, 1.0 - th2 / 6.0, jnp.sin(th) / th)  # sin(th)/th
+    b = jnp.where(small, 0.5 - th2 / 24.0, (1.0 - jnp.cos(th)) / jnp.where(small, 1.0, th2))
+    K = jnp.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
+    return jnp.eye(3) + a * K + b * (K @ K)
 
 
 def specific_force(t: ArrayLike, y: State, params: CeltParams) -> Array:
@@ -175,6 +196,8 @@ def generate_data(
     omega_pis: Sequence[float] | None = None,
     rtol: float = 1e-10,
     atol: float = 1e-12,
+    sensor_rotation: ArrayLike | None = None,
+    time_offset: float | Sequence[float] = 0.0,
 ) -> MeasuredData:
     """Synthetic "measured" records: simulate at ``params`` and sample, with Gaussian noise.
 
@@ -191,6 +214,10 @@ def generate_data(
         seed: numpy random seed (reproducible).
         omega_pis: base frequency per trajectory [rad/s]; default ``params.omega_pi`` for all.
         rtol, atol: integration tolerances (tighter than a fit uses, so data are "exact").
+        sensor_rotation: rotation vector (3,) [rad] from body to sensor axes: ``"omega"`` and
+            ``"accel"`` are recorded in sensor axes, R h (`rotation_matrix`); default none.
+        time_offset: model time minus record time [s] (one, or one per trajectory): the record
+            starts (t = 0, state y0) at model time ``time_offset``, i.e. at that phase of the base's motion.
 
     Returns:
         `MeasuredData`; ``meta`` records the true parameters and the settings; each trajectory
@@ -207,18 +234,25 @@ def generate_data(
             raise ValueError(f"generate_data: unknown observation kind {k!r}; known: {sorted(OBSERVABLES)}")
     if not (rate > 0 and noise >= 0):
         raise ValueError(f"generate_data: need rate > 0 and noise >= 0, got rate={rate}, noise={noise}")
+    offsets = np.broadcast_to(np.asarray(time_offset, float), (nt,))
+    Rs = np.asarray(rotation_matrix(np.zeros(3) if sensor_rotation is None else sensor_rotation))
     rng = np.random.default_rng(seed)
     trajs = []
     for i in range(nt):
         p = params.replace(omega_pi=float(omega_pis[i]))
         ts = np.arange(0.0, t1s[i] + 0.5 / rate, 1.0 / rate)
         ts = ts[ts <= t1s[i] + 1e-12]
-        sol = simulate(p, jnp.asarray(y0s[i]), float(ts[-1]), ts=jnp.asarray(ts), rtol=rtol, atol=atol)
+        tm = ts + offsets[i]  # model time
+        sol = simulate(
+            p, jnp.asarray(y0s[i]), float(tm[-1]), t0=float(tm[0]), ts=jnp.asarray(tm), rtol=rtol, atol=atol
+        )
         if not bool(sol.success) or not bool(sol.valid):
             raise ValueError(f"generate_data: trajectory {i} failed or left the model's validity: {sol.summary()}")
         obs, sig = {}, {}
         for k in kinds:
             clean = np.asarray(jax.vmap(lambda y, t, k=k, p=p: observe(y, p, k, t))(sol.ys, sol.ts))
+            if k in SENSOR_KINDS:
+                clean = clean @ Rs.T
             rms = np.sqrt(np.mean(clean**2, axis=0))
             rms = np.maximum(rms, 1e-6 * rms.max())
             sigma = (noise if noise > 0 else 0.01) * rms
@@ -236,6 +270,8 @@ def generate_data(
         rate=float(rate),
         seed=int(seed),
         kinds=list(kinds),
+        sensor_rotation=[0.0, 0.0, 0.0] if sensor_rotation is None else np.asarray(sensor_rotation, float).tolist(),
+        time_offset=offsets.tolist(),
     )
     return MeasuredData(tuple(trajs), meta)
 

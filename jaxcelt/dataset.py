@@ -176,6 +176,27 @@ def to_dataset(result: Any, params: CeltParams, config: Any, **classify_kwargs) 
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
+def to_lanes_dataset(
+    lanes: dict[str, np.ndarray],
+    *,
+    lane_values: dict[str, np.ndarray],
+    params: CeltParams,
+    config: Any,
+    **classify_kwargs,
+) -> xr.Dataset:
+    """A dataset of an arbitrary batch of lanes (`jaxcelt.sweep.sweep_lanes`): dim ``lane``, each
+    varied parameter a coordinate along it."""
+    n = len(lanes["status"])
+    coords: dict[str, Any] = {"lane": np.arange(n), **_base_coords(lanes["samples"].shape[-2])}
+    coords.update({k: ("lane", np.asarray(v)) for k, v in lane_values.items()})
+    data = _lane_variables(lanes, ("lane",), **classify_kwargs)
+    names = ", ".join(lane_values) or "lanes"
+    attrs = _attrs(params, names, config, 1)
+    attrs["title"] = f"jaxcelt stroboscopic lanes over {names}"
+    attrs["classify_json"] = json.dumps(classify_kwargs, sort_keys=True)
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
 def to_map_dataset(
     lanes: dict[str, np.ndarray],
     *,

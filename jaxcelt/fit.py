@@ -45,7 +45,7 @@ import optimistix as optx
 
 from . import _config  # noqa: F401
 from ._types import Array, State
-from .data import OBSERVABLES, MeasuredData, observe
+from .data import OBSERVABLES, SENSOR_KINDS, MeasuredData, observe, rotation_matrix
 from .model import contact_geometry
 from .params import PARAM_NAMES, CeltParams
 from .solve import simulate
@@ -66,9 +66,13 @@ __all__ = [
     "gradient_norm_vs_window",
     "multistart",
     "profile_likelihood",
+    "fit_staged",
 ]
 
 OPTIMISERS = ("lm", "gn", "gn-damped", "adam", "lbfgs")
+
+TIME_OFFSET_SCALE = 0.01
+"""Scale [s] of the optimised time offsets (z = offset / TIME_OFFSET_SCALE)."""
 
 STATE_SCALE = np.array([0.1, 0.1, 0.1, 1.0, 1.0, 1.0, 0.1, 0.1, 0.1, 0.01, 0.01, 0.01, 0.1])
 """Typical size of a change of each state component (v [m/s], omega [rad/s], n [-], r_C [m],
@@ -169,6 +173,8 @@ class _Record(eqx.Module):
     fixed_states: Array  # (R, K, 13) states of windows that are not optimised
     omega_pi: Array  # (R,)
     q_pi: Array  # (R,)
+    rotation0: Array  # (3,) given sensor rotation vector (body -> sensor axes) [rad]
+    offset0: Array  # (R,) given time offsets: model time = record time + offset [s]
     free_windows: tuple[int, ...] = eqx.field(static=True)
 
 
@@ -187,6 +193,8 @@ class _Problem(eqx.Module):
     rtol: float = eqx.field(static=True)
     atol: float = eqx.field(static=True)
     max_steps: int = eqx.field(static=True)
+    fit_rotation: bool = eqx.field(static=True, default=False)
+    fit_time_offset: bool = eqx.field(static=True, default=False)
 
     @property
     def n_records(self) -> int:
@@ -208,6 +216,12 @@ class _Problem(eqx.Module):
         if self.rec.free_windows:
             return fixed.at[jnp.array(self.rec.free_windows)].set(zs * STATE_SCALE[None, :])
         return fixed
+
+    def sensor(self, z) -> tuple[Array, Array]:
+        """(rotation vector (3,) of the sensor axes [rad], time offsets (R,) [s]): given + fitted."""
+        rv = self.rec.rotation0 + (z["rotation"] if self.fit_rotation else 0.0)
+        off = self.rec.offset0 + (z["offsets"] * TIME_OFFSET_SCALE if self.fit_time_offset else 0.0)
+        return rv, off
 
     def _simulate_record(self, p, zs, fixed, ts) -> tuple[Array, Array]:
         s = jax.vmap(lambda y: project_state(y, p))(self._window_states(zs, fixed))
@@ -233,9 +247,10 @@ class _Problem(eqx.Module):
         """States (R, K, n+1, 13) in every window of every record, and the solver status (R, K)."""
         p = self.params(z["params"])
         rec = self.rec
+        _, off = self.sensor(z)
         return jax.lax.map(
-            lambda a: self._simulate_record(self._record_params(p, a[3], a[4]), a[0], a[1], a[2]),
-            (z["states"], rec.fixed_states, rec.ts, rec.omega_pi, rec.q_pi),
+            lambda a: self._simulate_record(self._record_params(p, a[3], a[4]), a[0], a[1], a[2] + a[5]),
+            (z["states"], rec.fixed_states, rec.ts, rec.omega_pi, rec.q_pi, off),
         )
 
     def residuals(self, z, args=None) -> tuple[Array, dict]:
@@ -246,13 +261,18 @@ class _Problem(eqx.Module):
         kinds = self.kinds
         wts = {k: jnp.sqrt(self.weights[k]) for k in kinds}
         cw = jnp.sqrt(self.continuity_weight)
+        rv, off = self.sensor(z)
+        Rs = rotation_matrix(rv)
 
-        def one(zs, fixed, ts, om, q, obs, mask, inv_sigma):
+        def one(zs, fixed, ts, om, q, obs, mask, inv_sigma, dt):
             pr = self._record_params(p, om, q)
+            ts = ts + dt  # model time of the record's samples
             ys, _ = self._simulate_record(pr, zs, fixed, ts)
             mis, pen = [], []
             for kind in kinds:
                 h = jax.vmap(jax.vmap(lambda y, t, kind=kind: observe(y, pr, kind, t)))(ys, ts)
+                if kind in SENSOR_KINDS:
+                    h = h @ Rs.T  # body -> sensor axes
                 r = (h - obs[kind]) * inv_sigma[kind][None, None, :] * wts[kind] * mask[kind][..., None]
                 # window k>0 starts at the previous window's last sample: count it once
                 mis.append(jnp.concatenate([r[0].reshape(-1), r[1:, 1:].reshape(-1)]))
@@ -270,7 +290,7 @@ class _Problem(eqx.Module):
         # steps every lane until the slowest is done, at several times the cost of a sequence
         rm, rp = jax.lax.map(
             lambda a: one(*a),
-            (z["states"], rec.fixed_states, rec.ts, rec.omega_pi, rec.q_pi, rec.obs, rec.mask, rec.inv_sigma),
+            (z["states"], rec.fixed_states, rec.ts, rec.omega_pi, rec.q_pi, rec.obs, rec.mask, rec.inv_sigma, off),
         )
         rm, rp = rm.reshape(-1), rp.reshape(-1)
         # a failed or diverging solve gives inf/NaN samples: a large finite residual lets the
@@ -295,14 +315,25 @@ class _Problem(eqx.Module):
         return 0.5 * jnp.sum(self.residuals(z)[0] ** 2)
 
     # -- flat interface for the optimisers ---------------------------------------------------
+    @property
+    def n_nuisance(self) -> int:
+        """Unknowns after the parameters and before the window states: rotation (3), offsets (R)."""
+        return 3 * self.fit_rotation + self.n_records * self.fit_time_offset
+
     def unflatten(self, zf: Array) -> dict:
         P = len(self.free)
         R = self.n_records
         k = len(self.rec.free_windows)
-        return {"params": zf[:P], "states": zf[P:].reshape(R, k, 13)}
+        nr, no = 3 * self.fit_rotation, R * self.fit_time_offset
+        return {
+            "params": zf[:P],
+            "rotation": zf[P : P + nr],
+            "offsets": zf[P + nr : P + nr + no],
+            "states": zf[P + nr + no :].reshape(R, k, 13),
+        }
 
     def flatten(self, z: dict) -> Array:
-        return jnp.concatenate([z["params"], z["states"].reshape(-1)])
+        return jnp.concatenate([z["params"], z["rotation"], z["offsets"], z["states"].reshape(-1)])
 
     def value_and_jacobian(self, zf: Array) -> tuple[Array, Array]:
         """r (M,) and the forward-mode Jacobian dr/dz (M, len(zf)) in one batched JVP pass."""
@@ -353,6 +384,8 @@ class FitResult:
     total_time: float
     z: Any = None
     problem: Any = None
+    nuisance: dict[str, Any] = dataclasses.field(default_factory=dict)
+    """sensor rotation vector [rad] and time offsets [s] (given or fitted; ``*_stderr`` when fitted)"""
 
     def relative_error(self, true: dict[str, float] | CeltParams) -> dict[str, float]:
         """|fitted - true| / |true| per free parameter."""
@@ -373,6 +406,13 @@ class FitResult:
         for n in self.free:
             lo, hi = self.ci95[n]
             lines.append(f"  {n:>8s} = {self.values[n]:.6g} +- {self.stderr[n]:.3g}  (95%: [{lo:.6g}, {hi:.6g}])")
+        nu = self.nuisance
+        if "rotation_vector_stderr" in nu:
+            rv, se = nu["rotation_vector"], nu["rotation_vector_stderr"]
+            lines.append("  sensor rotation vector [rad] = " + ", ".join(f"{a:.4g} +- {b:.2g}" for a, b in zip(rv, se)))
+        if "time_offset_stderr" in nu:
+            to, se = nu["time_offset"], nu["time_offset_stderr"]
+            lines.append("  time offsets [s] = " + ", ".join(f"{a:.5g} +- {b:.2g}" for a, b in zip(to, se)))
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
@@ -398,6 +438,7 @@ class FitResult:
             wall_time=self.wall_time,
             compile_time=self.compile_time,
             total_time=self.total_time,
+            nuisance=self.nuisance,
         )
 
 
@@ -416,6 +457,10 @@ def _build(
     rtol: float,
     atol: float,
     max_steps: int,
+    sensor_rotation: Any = None,
+    time_offset: Any = 0.0,
+    fit_rotation: bool = False,
+    fit_time_offset: bool = False,
 ) -> tuple[_Problem, dict]:
     trs = []
     for n in free:
@@ -495,6 +540,14 @@ def _build(
         if m < n1 and windows > 1:
             raise ValueError("fit: multiple shooting needs records of equal length (pad or cut them)")
     fixed = np.stack([f for _, _, f in per])
+    rv0 = np.zeros(3) if sensor_rotation is None else np.asarray(sensor_rotation, float)
+    if rv0.shape != (3,) or not np.all(np.isfinite(rv0)):
+        raise ValueError(f"fit: sensor_rotation must be a finite rotation vector (3,) [rad], got {sensor_rotation!r}")
+    off0 = np.broadcast_to(np.asarray(time_offset, float), (R,)) if np.ndim(time_offset) < 2 else None
+    if off0 is None or not np.all(np.isfinite(off0)):
+        raise ValueError(f"fit: time_offset must be a finite scalar or one per record, got {time_offset!r}")
+    if (fit_rotation or fit_time_offset) and not (set(kinds) & set(SENSOR_KINDS)):
+        raise ValueError(f"fit: fit_rotation/fit_time_offset need sensor observations {SENSOR_KINDS}, have {kinds}")
     rec = _Record(
         ts=jnp.asarray(ts),
         obs={k: jnp.asarray(v) for k, v in obs.items()},
@@ -503,6 +556,8 @@ def _build(
         fixed_states=jnp.asarray(fixed),
         omega_pi=jnp.asarray([tr.omega_pi for tr, _, _ in per], float),
         q_pi=jnp.asarray([tr.q_pi for tr, _, _ in per], float),
+        rotation0=jnp.asarray(rv0),
+        offset0=jnp.asarray(np.array(off0)),
         free_windows=tuple(free_w),
     )
     z_states = jnp.asarray(fixed[:, free_w] / STATE_SCALE) if free_w else jnp.zeros((R, 0, 13))
@@ -520,8 +575,15 @@ def _build(
         rtol=rtol,
         atol=atol,
         max_steps=max_steps,
+        fit_rotation=bool(fit_rotation),
+        fit_time_offset=bool(fit_time_offset),
     )
-    z0 = {"params": jnp.zeros(len(free)), "states": z_states}
+    z0 = {
+        "params": jnp.zeros(len(free)),
+        "rotation": jnp.zeros(3 if fit_rotation else 0),
+        "offsets": jnp.zeros(R if fit_time_offset else 0),
+        "states": z_states,
+    }
     return prob, z0
 
 
@@ -660,6 +722,10 @@ def fit(
     windows: int = 1,
     window_states: str = "optimise",
     fit_y0: bool = False,
+    sensor_rotation: Any = None,
+    fit_rotation: bool = False,
+    time_offset: Any = 0.0,
+    fit_time_offset: bool = False,
     continuity_weight: float = 1e4,
     max_iter: int = 100,
     rtol: float = 1e-8,
@@ -693,6 +759,13 @@ def fit(
             (fixed to the projected measured states; needs ``"state"`` observations).
         fit_y0: also optimise the first window's initial state (else: the record's known y0, or
             its first projected full-state sample).
+        sensor_rotation: rotation vector (3,) [rad] from body to sensor axes of the gyro
+            (``"omega"``) and accelerometer (``"accel"``) observations: h_sensor = R h_body
+            (`jaxcelt.data.rotation_matrix`); default none. With ``fit_rotation`` it is the
+            starting value of a fitted rotation shared by all records.
+        time_offset: model time minus record time [s] (scalar or one per record), i.e. the phase
+            of the base's motion at the record's t = 0; default 0. With ``fit_time_offset`` the
+            starting value of a fitted offset per record.
         continuity_weight: weight of the continuity and gauge residuals (residual scale
             `STATE_SCALE` / sqrt(weight)).
         max_iter: iteration budget. rtol, atol: optimistix termination (relative/absolute change
@@ -729,6 +802,10 @@ def fit(
         sim_rtol,
         sim_atol,
         max_steps,
+        sensor_rotation,
+        time_offset,
+        fit_rotation,
+        fit_time_offset,
     )
     P = len(free)
     m = prob.n_residuals
@@ -811,6 +888,8 @@ def fit(
     par_hist.append(values_of(zf))
     n_unk = int(zf.size)
     values = values_of(zf)
+    rv_fit, off_fit = (np.asarray(a) for a in prob.sensor(z))
+    nuisance: dict[str, Any] = {"rotation_vector": rv_fit.tolist(), "time_offset": off_fit.tolist()}
     stderr = dict.fromkeys(free, np.nan)
     ci = {n: (np.nan, np.nan) for n in free}
     cov = np.full((P, P), np.nan)
@@ -824,9 +903,16 @@ def fit(
         try:  # a fit that ended in a failing-solve region can leave a non-finite Jacobian
             if not np.all(np.isfinite(H)):
                 raise np.linalg.LinAlgError("non-finite Gauss-Newton matrix")
-            cov_z = s2 * np.linalg.pinv(H, rcond=1e-13, hermitian=True)[:P, :P]
+            cov_full = s2 * np.linalg.pinv(H, rcond=1e-13, hermitian=True)
         except np.linalg.LinAlgError:
-            cov_z = np.full((P, P), np.nan)
+            cov_full = np.full((n_unk, n_unk), np.nan)
+        cov_z = cov_full[:P, :P]
+        se_n = np.sqrt(np.maximum(np.diag(cov_full)[P : P + prob.n_nuisance], 0.0))
+        nr = 3 * prob.fit_rotation
+        if prob.fit_rotation:
+            nuisance["rotation_vector_stderr"] = se_n[:nr].tolist()
+        if prob.fit_time_offset:
+            nuisance["time_offset_stderr"] = (se_n[nr:] * TIME_OFFSET_SCALE).tolist()
         dth = np.asarray(jax.jacfwd(prob.theta)(z["params"]))
         cov = dth @ cov_z @ dth.T
         se = np.sqrt(np.maximum(np.diag(cov), 0.0))
@@ -861,6 +947,7 @@ def fit(
         total_time=total,
         z=z,
         problem=prob,
+        nuisance=nuisance,
     )
 
 
@@ -872,6 +959,8 @@ def predict(result: FitResult) -> list[dict[str, Any]]:
     """
     prob, z = result.problem, result.z
     ys_all, _ = eqx.filter_jit(lambda pr, zz: pr.simulate_windows(zz))(dataclasses.replace(prob, mode="rev"), z)
+    rv, off = prob.sensor(z)
+    Rs = rotation_matrix(rv)
     out = []
     for i in range(prob.n_records):
         rec = prob.rec
@@ -880,11 +969,45 @@ def predict(result: FitResult) -> list[dict[str, Any]]:
         p = eqx.tree_at(lambda q: (q.omega_pi, q.q_pi), p, (rec.omega_pi[i], rec.q_pi[i]))
         d = {"ts": np.asarray(rec.ts[i]), "ys": np.asarray(ys)}
         for kind in OBSERVABLES:
-            d[kind] = np.asarray(jax.vmap(jax.vmap(lambda y, t, kind=kind, p=p: observe(y, p, kind, t)))(ys, rec.ts[i]))
+            h = jax.vmap(jax.vmap(lambda y, t, kind=kind, p=p: observe(y, p, kind, t)))(ys, rec.ts[i] + off[i])
+            d[kind] = np.asarray(h @ Rs.T if kind in SENSOR_KINDS else h)
         d["data"] = {k: np.asarray(v[i]) for k, v in rec.obs.items()}
         d["mask"] = {k: np.asarray(v[i]) > 0 for k, v in rec.mask.items()}
         out.append(d)
     return out
+
+
+# ----------------------------------------------------------------------------- growing spans
+def _truncate(data: MeasuredData, t_end: float) -> MeasuredData:
+    trs = []
+    for tr in data.trajectories:
+        keep = tr.ts <= tr.ts[0] + t_end + 1e-9
+        trs.append(dataclasses.replace(tr, ts=tr.ts[keep], obs={k: v[keep] for k, v in tr.obs.items()}))
+    return MeasuredData(tuple(trs), data.meta)
+
+
+def fit_staged(data: MeasuredData, params0: CeltParams, spans: Sequence[float], **fit_kw) -> FitResult:
+    """`fit` on the first ``spans[0]`` seconds of every record, then on longer spans, each fit
+    started from the last one's parameters, release states (``fit_y0``), sensor rotation and time
+    offsets. Over a short span the loss is nearly quadratic in a roughly known release and in the
+    offsets, which over the whole record would trap the fit in a local minimum (measured in
+    ``scripts/fit_sensor_study.py``). Returns the last fit (make the last span cover the records)."""
+    if not spans or any(not (s > 0) for s in spans):
+        raise ValueError(f"fit_staged: spans must be positive durations [s], got {spans!r}")
+    kw = dict(fit_kw)
+    p, res = params0, None
+    y0s = [tr.y0 for tr in data.trajectories]
+    for span in spans:
+        d = _truncate(data, float(span))
+        d = MeasuredData(tuple(dataclasses.replace(tr, y0=y) for tr, y in zip(d.trajectories, y0s)), d.meta)
+        res = fit(d, p, **kw)
+        p = res.params
+        kw["sensor_rotation"] = res.nuisance["rotation_vector"]
+        kw["time_offset"] = res.nuisance["time_offset"]
+        if kw.get("fit_y0"):
+            states = np.asarray(res.z["states"])[:, 0] * STATE_SCALE
+            y0s = [np.asarray(project_state(jnp.asarray(s), p)) for s in states]
+    return res
 
 
 # ----------------------------------------------------------------------------- multi-start, profile likelihood

@@ -115,6 +115,7 @@ __all__ = [
     "run_lanes",
     "run_lanes_with_stats",
     "parameter_map",
+    "sweep_lanes",
 ]
 
 
@@ -314,6 +315,143 @@ def _run_all(
     return _run_chunked(pb_all, lane_y0, cfg, chunks, pad_to, writer, writer.load_done(), **kwargs)
 
 
+def _run_batch(
+    pb_all: CeltParams,
+    lane_y0: np.ndarray,
+    cfg: SweepConfig,
+    *,
+    params: CeltParams,
+    names: Sequence[str],
+    lane_values: np.ndarray,
+    n_starts: int,
+    chunk_size: int | None,
+    sort_by_cost: bool,
+    devices: Sequence[Any] | None,
+    width: int | None,
+    out: str | None,
+    progress: bool,
+    on_chunk: Callable[[int, dict[str, np.ndarray]], None] | None,
+    desc: str,
+) -> tuple[dict[str, np.ndarray] | None, Any]:
+    """Chunking, resumable writing and the multi-process split of a batch of lanes, shared by
+    `sweep`, `parameter_map` and `sweep_lanes`: (lane results in lane order or None on a process
+    other than 0 of a multi-process run, the `jaxcelt.dataset.SweepWriter` or None)."""
+    if not np.all(np.asarray(pb_all.omega_pi) > 0):
+        raise ValueError("stroboscopic sampling needs omega_pi > 0 in every lane")
+    L = lane_y0.shape[0]
+    order = np.arange(L)
+    if sort_by_cost:
+        order = np.argsort(np.asarray(pb_all.omega_pi), kind="stable")  # longest period first
+    cs = L if chunk_size is None else max(1, min(int(chunk_size), L))  # no padding beyond the lanes
+    chunks = [order[i : i + cs] for i in range(0, L, cs)]
+    writer = None
+    done: dict[int, dict[str, np.ndarray]] = {}
+    if out is not None:
+        from .dataset import SweepWriter
+
+        writer = SweepWriter(
+            out,
+            params=params,
+            name=names[0] if len(names) == 1 else list(names),
+            lane_values=lane_values,
+            lane_y0=lane_y0,
+            n_starts=n_starts,
+            config=cfg,
+            chunks=chunks,
+        )
+        done = writer.load_done()
+    lanes = _run_all(
+        pb_all, lane_y0, cfg, chunks, cs, writer, done,
+        devices=devices, width=width, varying=tuple(names), progress=progress, desc=desc, on_chunk=on_chunk,
+    )  # fmt: skip
+    return lanes, writer
+
+
+def _batched_params(params: CeltParams, lane_values: dict[str, np.ndarray]) -> CeltParams:
+    names = list(lane_values)
+    pb = lanes_params(params, names[0], lane_values[names[0]])
+    for n in names[1:]:
+        pb = eqx.tree_at(lambda p, n=n: getattr(p, n), pb, jnp.asarray(lane_values[n], jnp.float64))
+    return pb
+
+
+def sweep_lanes(
+    params: CeltParams,
+    lanes: dict[str, Any],
+    *,
+    y0: Any = None,
+    transient_periods: int = 200,
+    sample_periods: int = 100,
+    lyapunov_periods: int = 0,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    max_steps: int = 1_000_000,
+    solver: diffrax.AbstractSolver | None = None,
+    contact_law: AbstractContactLaw | str | None = None,
+    t0: float = 0.0,
+    chunk_size: int | None = None,
+    sort_by_cost: bool = False,
+    stop_on_invalid: bool = False,
+    dtype: Any = "float64",
+    width: int | None = None,
+    devices: Sequence[Any] | None = None,
+    out: str | None = None,
+    progress: bool = False,
+    on_chunk: Callable[[int, dict[str, np.ndarray]], None] | None = None,
+) -> Any:
+    """Any batch of lanes: lane i has the parameters ``{name: values[i]}`` (others from ``params``)
+    and the start ``y0[i]``; the same engine, sampling and options as `sweep`.
+
+    Args:
+        lanes: ``{name: (L,) values}`` for any `CeltParams` fields (e.g. random draws of
+            ``omega_pi``, ``q_pi`` and ``mu`` together); ``{}`` with ``y0`` (L, 13) varies the start only.
+        y0: None (at rest, `initial_state`), (13,) for every lane, or (L, 13) one per lane.
+        other arguments: as `sweep`.
+
+    Returns:
+        `xarray.Dataset` with dims ``(lane, sample, state)``: the variables of a sweep dataset and
+        the regime labels, each varied parameter a coordinate along ``lane``; with ``out`` also
+        written to ``out/sweep.nc``. In a multi-process run, process 0 returns it, the others None.
+    """
+    cfg = _sweep_config(
+        transient_periods, sample_periods, lyapunov_periods, rtol, atol, max_steps, solver, contact_law, t0,
+        stop_on_invalid, dtype,
+    )  # fmt: skip
+    if not isinstance(lanes, dict):
+        raise ValueError(f"lanes must be a dict {{parameter name: values}}, got {type(lanes).__name__}")
+    vals = {n: _checked_values(n, v, params) for n, v in lanes.items()}
+    sizes = {len(v) for v in vals.values()}
+    y = None if y0 is None else np.asarray(y0, dtype=np.float64)
+    if y is not None and y.ndim == 2:
+        sizes.add(y.shape[0])
+    if len(sizes) != 1:
+        raise ValueError(f"lanes: every parameter's values and y0 (L, 13) need the same length, got {sorted(sizes)}")
+    L = sizes.pop()
+    if y is None or y.ndim == 1:
+        y = np.tile(_broadcast_y0(params, y, 1)[0, 0], (L, 1))
+    if y.shape != (L, 13) or not np.all(np.isfinite(y)):
+        raise ValueError(f"y0 must be finite with shape (13,) or ({L}, 13), got {np.shape(y0)}")
+    for i in range(L):  # every lane's parameters must be valid (ValueError naming the field)
+        params.replace(**{n: float(v[i]) for n, v in vals.items()})
+    if not vals:  # starts only: omega_pi rides along (the engine needs one lane-varying leaf)
+        vals = {"omega_pi": np.full(L, float(params.omega_pi))}
+    names = list(vals)
+    lane_values = np.stack([vals[n] for n in names], axis=1)
+    lanes_out, writer = _run_batch(
+        _batched_params(params, vals), np.ascontiguousarray(y), cfg, params=params, names=names,
+        lane_values=lane_values, n_starts=1, chunk_size=chunk_size, sort_by_cost=sort_by_cost, devices=devices,
+        width=width, out=out, progress=progress, on_chunk=on_chunk, desc="lanes",
+    )  # fmt: skip
+    if lanes_out is None:
+        return None
+    from .dataset import to_lanes_dataset
+
+    ds = to_lanes_dataset(lanes_out, lane_values=vals, params=params, config=cfg)
+    if writer is not None:
+        writer.write_dataset(ds)
+    return ds
+
+
 def sweep(
     params: CeltParams,
     name: str,
@@ -390,37 +528,10 @@ def sweep(
     Lv, K = y0v.shape[:2]
     lane_values = np.repeat(values, K)
     lane_y0 = y0v.reshape(Lv * K, 13)
-    L = Lv * K
-    pb_all = lanes_params(params, name, lane_values)
-    if not np.all(np.asarray(pb_all.omega_pi) > 0):
-        raise ValueError("stroboscopic sampling needs omega_pi > 0 in every lane")
-    order = np.arange(L)
-    if sort_by_cost:
-        order = np.argsort(np.asarray(pb_all.omega_pi), kind="stable")  # longest period first
-    cs = L if chunk_size is None else max(1, min(int(chunk_size), L))  # no padding beyond the lanes
-    chunks = [order[i : i + cs] for i in range(0, L, cs)]
-
-    writer = None
-    done: dict[int, dict[str, np.ndarray]] = {}
-    if out is not None:
-        from .dataset import SweepWriter
-
-        writer = SweepWriter(
-            out,
-            params=params,
-            name=name,
-            lane_values=lane_values,
-            lane_y0=lane_y0,
-            n_starts=K,
-            config=cfg,
-            chunks=chunks,
-        )
-        done = writer.load_done()
-
-    lanes = _run_all(
-        pb_all, lane_y0, cfg, chunks, cs, writer, done,
-        devices=devices, width=width, varying=(name,),
-        progress=progress, desc=f"sweep {name}", on_chunk=on_chunk,
+    lanes, writer = _run_batch(
+        lanes_params(params, name, lane_values), lane_y0, cfg, params=params, names=[name], lane_values=lane_values,
+        n_starts=K, chunk_size=chunk_size, sort_by_cost=sort_by_cost, devices=devices, width=width, out=out,
+        progress=progress, on_chunk=on_chunk, desc=f"sweep {name}",
     )  # fmt: skip
     if lanes is None:  # a process other than 0 of a multi-process sweep: its chunks are on disk
         return None
@@ -533,39 +644,14 @@ def parameter_map(
     y0v = _broadcast_y0(params, y0, 1)[0]  # (K, 13)
     K = y0v.shape[0]
     nx, ny = len(xs), len(ys)
-    L = nx * ny * K
     lane_x = np.repeat(xs, ny * K)
     lane_y = np.tile(np.repeat(ys, K), nx)
     lane_y0 = np.ascontiguousarray(np.tile(y0v, (nx * ny, 1)))
-    pb_all = lanes_params(params, xn, lane_x)
-    pb_all = eqx.tree_at(lambda p: getattr(p, yn), pb_all, jnp.asarray(lane_y))
-    if not np.all(np.asarray(pb_all.omega_pi) > 0):
-        raise ValueError("stroboscopic sampling needs omega_pi > 0 in every lane")
-    order = np.arange(L)
-    if sort_by_cost:
-        order = np.argsort(np.asarray(pb_all.omega_pi), kind="stable")  # longest period first
-    cs = L if chunk_size is None else max(1, min(int(chunk_size), L))
-    chunks = [order[i : i + cs] for i in range(0, L, cs)]
-    writer = None
-    done: dict[int, dict[str, np.ndarray]] = {}
-    if out is not None:
-        from .dataset import SweepWriter
-
-        writer = SweepWriter(
-            out,
-            params=params,
-            name=[xn, yn],
-            lane_values=np.stack([lane_x, lane_y], axis=1),
-            lane_y0=lane_y0,
-            n_starts=K,
-            config=cfg,
-            chunks=chunks,
-        )
-        done = writer.load_done()
-    lanes = _run_all(
-        pb_all, lane_y0, cfg, chunks, cs, writer, done,
-        devices=devices, width=width, varying=(xn, yn),
-        progress=progress, desc=f"map {xn} x {yn}", on_chunk=on_chunk,
+    lanes, writer = _run_batch(
+        _batched_params(params, {xn: lane_x, yn: lane_y}), lane_y0, cfg, params=params, names=[xn, yn],
+        lane_values=np.stack([lane_x, lane_y], axis=1), n_starts=K, chunk_size=chunk_size,
+        sort_by_cost=sort_by_cost, devices=devices, width=width, out=out, progress=progress, on_chunk=on_chunk,
+        desc=f"map {xn} x {yn}",
     )  # fmt: skip
     if lanes is None:  # a process other than 0 of a multi-process map
         return None

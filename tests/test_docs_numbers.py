@@ -288,3 +288,30 @@ def test_readme_test_count():
     assert m, out[-500:]
     quoted = re.search(r"default test suite \((\d+) tests", _text("README.md"))
     assert quoted and int(quoted[1]) == int(m[1]), f"README says {quoted and quoted[1]}, pytest collects {m[1]}"
+
+
+def test_gpu_table_from_gpu_map_json():
+    """Every GPU run in docs/performance/gpu_map.json appears in the engine's GPU table (times to 0.1 s,
+    pool iterations with a space as thousands separator)."""
+    text = _text("docs/bifurcation/README.md")
+    runs = [r for r in _json("docs/performance/gpu_map.json")["runs"] if "run_s" in r]
+    assert len(runs) == 5
+    for r in runs:
+        row = f"| {r['grid'][0]} × {r['grid'][1]} | {r['periods']} | {r['dtype']}"
+        assert row in text, row
+        for quote in (f"{r['compile_s']:.1f} s", f"{r['run_s']:.1f} s", f"{r['steps_max']:,}".replace(",", " ")):
+            assert quote in text, quote
+
+
+def test_sensor_study_numbers_from_json():
+    """The sensor-axes study's summary in docs/identification.md against docs/fit/sensor_study.json."""
+    text = " ".join(_text("docs/identification.md").split())
+    d = _json("docs/fit/sensor_study.json")
+    s = d["summary"]
+    quotes = [f"Over {s['seeds']} noise seeds {s['converged']} fits converge"]
+    quotes += [f"{n} {100 * s[n]['median_rel_err']:.2f} %" for n in ("mu", "k_r", "b_Ts", "m_Ts")]
+    quotes += [f"{n} {100 * s[n]['coverage']:.0f} %" for n in ("mu", "k_r", "b_Ts", "m_Ts")]
+    quotes += [f"components {100 * s['rotation']['coverage']:.0f} % and the offsets {100 * s['time_offset']['coverage']:.0f} %"]
+    quotes += [f"s² = {d['whole_record_fit_seed0']['s2']:.0f}", f"compilation {s['run_s_median']:.1f} s"]
+    for q in quotes:
+        assert q in text, q

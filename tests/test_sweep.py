@@ -458,3 +458,46 @@ def open_sweep_regimes(result, params):
 
     cfg = SweepConfig(**{k: v for k, v in KW.items() if k != "chunk_size"})
     return to_dataset(result, params, cfg)["regime"].values
+
+
+def test_float32_pool_agrees_with_float64(paper_params):
+    """A float32 pool (``dtype="float32"``) against a float64 pool at the same loose tolerance, a few
+    sliding periods (omega_pi 15 and 17 from rest: no sticking). Tolerance 2e-3 on the samples: both
+    runs are within ~rtol 1e-6 of the true solution per step and float32 rounding (~6e-8 relative) adds
+    up over ~10^3 steps; the state components are O(0.01-10). Results come back as float64 arrays."""
+    kw = dict(transient_periods=2, sample_periods=3, rtol=1e-6, atol=1e-8)
+    r64 = bifurcation(paper_params, [15.0, 17.0], **kw)
+    r32 = bifurcation(paper_params, [15.0, 17.0], dtype="float32", **kw)
+    assert r32.samples.dtype == np.float64
+    np.testing.assert_array_equal(r32.status, r64.status)
+    assert np.all(r32.status == 0)
+    np.testing.assert_allclose(r32.samples, r64.samples, rtol=0, atol=2e-3)
+    with pytest.raises(ValueError, match="dtype"):
+        bifurcation(paper_params, [15.0], dtype="float16", **kw)
+
+
+def test_sweep_lanes_any_batch_equals_bifurcation(base, paper_params, tmp_path):
+    """`sweep_lanes` over an arbitrary batch (omega_pi and q_pi drawn per lane, shuffled, plus one
+    lane with another start): each lane equals the `bifurcation` lane with the same parameters and
+    start (another compiled program: same steps and status, samples within SAMPLE_ATOL)."""
+    from jaxcelt.sweep import sweep_lanes
+
+    om = np.array([17.0, 12.0, 19.0, 14.0, 17.0])
+    q = np.array([0.04, 0.04, 0.04, 0.04, 0.05])
+    ds = sweep_lanes(paper_params, {"omega_pi": om, "q_pi": q}, out=str(tmp_path / "lanes"), **KW)
+    assert ds["section"].dims == ("lane", "sample", "state") and ds["q_pi"].dims == ("lane",)
+    idx = [int(np.flatnonzero(VALUES == w)[0]) for w in om[:4]]
+    got = {"samples": ds["section"].values[:4], "num_steps": ds["num_steps"].values[:4], "status": ds["status"].values[:4]}
+    assert_same_lanes(got, {"samples": base.samples[idx], "num_steps": base.num_steps[idx], "status": base.status[idx]})
+    ref = bifurcation(paper_params.replace(q_pi=0.05), [17.0], **KW)
+    assert_same_lanes({k: v[4:] for k, v in got.items()},
+                      {"samples": ref.samples, "num_steps": ref.num_steps, "status": ref.status})  # fmt: skip
+    assert (tmp_path / "lanes" / "sweep.nc").exists()
+    # starts only (no parameter varied): y0 (L, 13)
+    y0 = np.stack([np.asarray(jc.initial_state(paper_params)), np.asarray(jc.initial_state(paper_params, psi=0.5))])
+    ds2 = sweep_lanes(paper_params, {}, y0=y0, **KW)
+    assert ds2.sizes["lane"] == 2 and np.all(ds2["status"].values == 0)
+    with pytest.raises(ValueError, match="same length"):
+        sweep_lanes(paper_params, {"omega_pi": om, "q_pi": q[:2]}, **KW)
+    with pytest.raises(ValueError, match="mu"):
+        sweep_lanes(paper_params, {"mu": [0.2, -0.1]}, **KW)

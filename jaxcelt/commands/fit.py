@@ -14,6 +14,17 @@ from pathlib import Path
 from .args import UsageError, override, overrides, positive_float, positive_int
 
 
+def floats_list(text: str) -> list[float]:
+    """``"0.3,1"`` -> [0.3, 1.0], positive values (argparse type)."""
+    try:
+        vals = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        vals = []
+    if not vals or any(not (v > 0) for v in vals):
+        raise argparse.ArgumentTypeError(f"expected positive numbers separated by commas, got {text!r}")
+    return vals
+
+
 def register(sub) -> None:
     p = sub.add_parser(
         "fit",
@@ -54,6 +65,12 @@ def register(sub) -> None:
     )
     p.add_argument("--window-states", choices=("optimise", "data"), default="optimise")
     p.add_argument("--fit-y0", action="store_true", help="also optimise the first initial state")
+    p.add_argument("--fit-rotation", action="store_true",
+                   help="also fit the sensor-to-body rotation of the gyro/accelerometer axes (3 angles)")  # fmt: skip
+    p.add_argument("--fit-time-offset", action="store_true",
+                   help="also fit each record's time offset (the base's phase at the record's t = 0)")  # fmt: skip
+    p.add_argument("--spans", type=floats_list, default=None, metavar="S1,S2,...",
+                   help="fit the first S1 seconds of every record, then S2, ... (jaxcelt.fit.fit_staged)")  # fmt: skip
     p.add_argument("--max-iter", type=positive_int, default=100)
     p.add_argument("--learning-rate", type=positive_float, default=0.02, help="Adam step size")
     p.add_argument("--out", type=Path, default=Path("out/fit"), help="output directory (fit.json, fit.png)")
@@ -67,7 +84,7 @@ def run(args) -> int:
 
     import jaxcelt as jc
     from jaxcelt.data import MeasuredData, load_csv, load_data
-    from jaxcelt.fit import fit
+    from jaxcelt.fit import fit, fit_staged
 
     # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2)
     params0 = jc.CeltParams.paper(**overrides(args.set))
@@ -98,9 +115,11 @@ def run(args) -> int:
         bar.set_postfix(loss=f"{loss:.4g}", **{k: f"{v:.4g}" for k, v in values.items()})
 
     try:
-        res = fit(
+        kw = dict(fit_rotation=args.fit_rotation, fit_time_offset=args.fit_time_offset)
+        res = (fit if args.spans is None else lambda d, p, **k: fit_staged(d, p, args.spans, **k))(
             data,
             params0,
+            **kw,
             free=tuple(args.free),
             optimiser=args.optimiser,
             windows=args.windows,

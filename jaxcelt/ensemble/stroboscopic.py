@@ -157,12 +157,12 @@ def _pool_chunk(
     width: int,
     mesh: Any,
     vary: tuple[bool, ...],
-    opaque_true: Array,
+    opaque_true: Array | None,
 ) -> tuple[dict[str, Array], Array, Array]:
     """One chunk of lanes through the pool (per device): per-lane outputs and the loop counters.
 
     ``opaque_true``: a traced True (a jit argument: XLA would fold a constant predicate and the
-    fused step's kernel boundaries would vanish). ``vary``: `jaxcelt.ensemble.split_lane_args`."""
+    fused step's kernel boundaries would vanish), or None: no kernel boundaries. ``vary``: `jaxcelt.ensemble.split_lane_args`."""
 
     def run(pb, y0b, live):
         stepper = _stepper(cfg, opaque_true)
@@ -228,8 +228,12 @@ def run_lanes_with_stats(
     tols = jnp.asarray([cfg.rtol, cfg.atol], dt)
     # the pilot pause only pays where lanes queue for slots
     frac = float(pilot_fraction) if pilot_fraction and Lloc > Wd else np.inf
+    # kernel boundaries pay on CPU (`jaxcelt.ensemble.kernel_boundary`); on an accelerator a
+    # conditional costs a device-to-host sync per stage, so none there
+    platform = (list(devices)[0] if devices else jax.local_devices()[0]).platform
+    opaque_true = jnp.asarray(True) if platform == "cpu" else None
     out, iters, slot_steps = _pool_chunk(
-        pb_p, y0_np[pos_lane].astype(dt), live, jnp.asarray(frac), transient, tols, nocfg, Wd, mesh, vary, jnp.asarray(True)
+        pb_p, y0_np[pos_lane].astype(dt), live, jnp.asarray(frac), transient, tols, nocfg, Wd, mesh, vary, opaque_true
     )
     stats = PoolStats(iterations=int(np.asarray(iters).max()), slot_steps=int(np.sum(np.asarray(slot_steps))), width=Wd)
     out = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(out))
