@@ -14,6 +14,7 @@ installed diffrax and equinox are inside them, that the names still exist, and t
 
 from __future__ import annotations
 
+import contextlib
 from typing import Any
 
 import diffrax
@@ -24,7 +25,41 @@ from diffrax._term import WrapTerm  # what diffeqsolve wraps terms in (not re-ex
 
 from ._types import Array
 
-__all__ = ["use_stepsize_tol", "wrap_term", "t1_clip_floor", "clip_to_end", "loop_init", "loop_step"]
+__all__ = [
+    "use_stepsize_tol",
+    "wrap_term",
+    "t1_clip_floor",
+    "clip_to_end",
+    "loop_init",
+    "loop_step",
+    "runtime_checks_as_nan",
+]
+
+
+@contextlib.contextmanager
+def runtime_checks_as_nan():
+    """While tracing inside this context, equinox's runtime checks (`eqx.error_if`, e.g.
+    diffeqsolve's "saveat.ts must lie between t0 and t1" on traced save times) return NaN
+    instead of raising through a host callback -- what ``EQX_ON_ERROR=nan`` does, for these traces
+    only. A program with a host callback is never stored in JAX's persistent compilation cache;
+    without them, a second process loads it instead of compiling it again. Only for programs whose
+    inputs are validated beforehand (a NaN then marks a failure the caller handles).
+
+    equinox routes a check on traced values through a jitted helper whose trace (made once per
+    process, in the default mode) is cached; inside the context the checks go to the un-jitted
+    implementation with ``on_error="nan"`` instead."""
+    import equinox._errors as eqx_errors  # private: the check's implementation and its jitted wrapper
+
+    old = eqx_errors.branched_error_if_impl_jit
+
+    def as_nan(x, pred, index, msgs, *, on_error):
+        return eqx_errors.branched_error_if_impl(x, pred, index, msgs, on_error="nan" if on_error == "default" else on_error)
+
+    eqx_errors.branched_error_if_impl_jit = as_nan
+    try:
+        yield
+    finally:
+        eqx_errors.branched_error_if_impl_jit = old
 
 
 def wrap_term(term: diffrax.AbstractTerm) -> diffrax.AbstractTerm:

@@ -44,6 +44,7 @@ import optax
 import optimistix as optx
 
 from . import _config  # noqa: F401
+from ._diffrax_adapter import runtime_checks_as_nan
 from ._types import Array, State
 from .data import OBSERVABLES, SENSOR_KINDS, MeasuredData, observe, rotation_matrix
 from .model import contact_geometry
@@ -70,6 +71,11 @@ __all__ = [
 ]
 
 OPTIMISERS = ("lm", "gn", "gn-damped", "adam", "lbfgs")
+
+STEPS_PER_SECOND = 2000
+"""Default step budget of a fit's solves per second of window (rounded up to whole seconds): a
+record of the stone's normal motion needs a few hundred steps per second at rtol 1e-8; the cap
+makes a trial point in a stiff parameter region fail fast (``benchmarks/bench_fit.py``)."""
 
 TIME_OFFSET_SCALE = 0.01
 """Scale [s] of the optimised time offsets (z = offset / TIME_OFFSET_SCALE)."""
@@ -609,8 +615,11 @@ _ACTIVE: list = [None]  # the problem the callbacks evaluate (set by `fit`; not 
 
 def _host_vj(zf):
     _CALLS[0] += 1
-    # one input type (a fresh array from numpy) for every caller: the jit cache hits
-    r, J = _value_and_jacobian(_ACTIVE[0], jnp.asarray(np.asarray(zf, np.float64)))
+    # one input type (a fresh array from numpy) for every caller: the jit cache hits. Traced
+    # without equinox's error callbacks (save times are checked by _build): the program can be
+    # stored in JAX's persistent compilation cache
+    with runtime_checks_as_nan():
+        r, J = _value_and_jacobian(_ACTIVE[0], jnp.asarray(np.asarray(zf, np.float64)))
     return np.asarray(r), np.asarray(J)
 
 
@@ -732,7 +741,7 @@ def fit(
     atol: float = 1e-8,
     sim_rtol: float = 1e-8,
     sim_atol: float = 1e-10,
-    max_steps: int = 10_000,
+    max_steps: int | None = None,
     learning_rate: float = 0.02,
     gtol: float = 1e-9,
     uncertainty: bool = True,
@@ -770,8 +779,9 @@ def fit(
             `STATE_SCALE` / sqrt(weight)).
         max_iter: iteration budget. rtol, atol: optimistix termination (relative/absolute change
             of z and of the loss).
-        sim_rtol, sim_atol, max_steps: integrator settings (max_steps per solve: a trial step into a
-            stiff region fails fast at the cap and is rejected).
+        sim_rtol, sim_atol, max_steps: integrator settings. max_steps per solve (default
+            `STEPS_PER_SECOND` per second of the longest window, at least that many): a trial
+            point of the optimiser in a stiff parameter region fails fast at the cap and is rejected.
         learning_rate: Adam initial step size in z (log-relative units for `Positive`
             parameters), decayed by a cosine schedule to 1e-3 of it over ``max_iter``.
         gtol: optax optimisers stop, converged, when |grad loss| <= gtol |grad loss at start|.
@@ -788,6 +798,9 @@ def fit(
     if isinstance(max_iter, bool) or not isinstance(max_iter, int) or max_iter < 1:
         raise ValueError(f"fit: max_iter must be a positive int, got {max_iter!r}")
     free = tuple(free)
+    if max_steps is None:
+        span = max(float(tr.ts[-1] - tr.ts[0]) for tr in data.trajectories) / max(int(windows), 1)
+        max_steps = int(STEPS_PER_SECOND * max(1.0, np.ceil(span)))
     prob, z = _build(
         data,
         params0,

@@ -114,3 +114,27 @@ def test_adapted_loop_takes_diffeqsolve_steps(solver, step_ts):
     np.testing.assert_allclose(np.asarray(got_t[:n_acc]), np.asarray(sol.ts[:n_acc]), rtol=1e-13, atol=0)
     np.testing.assert_allclose(np.asarray(got_y[:n_acc]), np.asarray(sol.ys[:n_acc]), rtol=0, atol=1e-13)
     assert float(got_t[n_acc - 1]) == t1  # the last accepted step ends on t1 exactly (clip_to_end)
+
+
+def test_runtime_checks_as_nan_removes_host_callbacks():
+    """Inside `runtime_checks_as_nan` a traced `eqx.error_if` lowers without a host callback and
+    returns NaN where it would raise; outside, equinox's default (a callback that raises) holds --
+    also after the jitted check was traced in the default mode first (its trace is cached)."""
+    import equinox as eqx
+    import jax
+    import jax.numpy as jnp
+    import numpy as np
+
+    from jaxcelt._diffrax_adapter import runtime_checks_as_nan
+
+    def f(x):
+        return eqx.error_if(x, x < 0, "x must be >= 0") + 1.0
+
+    plain = jax.jit(f).lower(jnp.asarray(1.0)).as_text()
+    with runtime_checks_as_nan():
+        low = jax.jit(lambda x: f(x) * 1.0).lower(jnp.asarray(1.0))
+    assert "callback" in plain and "callback" not in low.as_text()
+    comp = low.compile()
+    assert np.isnan(comp(jnp.asarray(-1.0))) and comp(jnp.asarray(2.0)) == 3.0
+    with pytest.raises(Exception, match="x must be >= 0"):
+        jax.jit(lambda x: f(x) * 2.0)(jnp.asarray(-1.0))

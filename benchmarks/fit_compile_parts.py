@@ -1,0 +1,90 @@
+"""Where a fit's compilation goes (writes docs/fit/compile_parts.json).
+
+The problem of ``benchmarks/bench_fit.py`` (two 1 s gyro records, 4 parameters). For the evaluation
+program (`jaxcelt.fit._value_and_jacobian`: residuals and forward-mode Jacobian) it times tracing +
+lowering and XLA compilation apart, counts the host callbacks in it, and -- in two fresh processes
+sharing an empty persistent compilation cache -- whether the second process loads it from the cache.
+Both with equinox's runtime checks as host callbacks (equinox's default) and traced inside
+`jaxcelt._diffrax_adapter.runtime_checks_as_nan` (what `jaxcelt.fit` does).
+
+    python benchmarks/fit_compile_parts.py [--out docs/fit/compile_parts.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+
+def child(mode: str) -> dict:
+    import numpy as np
+
+    import jaxcelt as jc
+    from jaxcelt._diffrax_adapter import runtime_checks_as_nan
+    from jaxcelt.data import generate_data
+
+    F = sys.modules["jaxcelt.fit"]
+    paper = jc.CeltParams.paper()
+    true = paper.replace(mu=0.2241 * 1.4, k_r=0.4345 * 0.6, b_Ts=0.5305 * 1.5, m_Ts=0.8161 * 1.35)
+
+    def start(spin, tilt):
+        t = np.radians(tilt)
+        return jc.initial_state(true, omega=(0.0, 0.0, spin), n=(np.sin(t), 0.0, np.cos(t)))
+
+    data = generate_data(true, [start(5.0, 10.0), start(-3.0, 6.0)], 1.0, rate=100, kinds=("omega",))
+    prob, z = F._build(data, paper, ("mu", "k_r", "b_Ts", "m_Ts"), {}, {}, 1, "optimise", False, 1e4, "fwd",
+                       1e-8, 1e-10, 2000)  # fmt: skip
+    zf = prob.flatten(z)
+    ctx = runtime_checks_as_nan() if mode == "nan" else contextlib.nullcontext()
+    with ctx:
+        t0 = time.perf_counter()
+        low = F._value_and_jacobian.lower(prob, zf)
+        t1 = time.perf_counter()
+    low.compile()
+    t2 = time.perf_counter()
+    return {
+        "trace_lower_s": round(t1 - t0, 3),
+        "compile_s": round(t2 - t1, 3),
+        "host_callbacks": low.as_text().count("callback"),
+    }
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, default=Path("docs/fit/compile_parts.json"))
+    ap.add_argument("--child", default=None, help=argparse.SUPPRESS)
+    a = ap.parse_args()
+    if a.child:
+        print(json.dumps(child(a.child)))
+        return 0
+    from jaxcelt.versions import versions
+
+    out = {"versions": versions(), "cpu_count": os.cpu_count(), "load_before": os.getloadavg(), "modes": {}}
+    for mode in ("raise", "nan"):
+        with tempfile.TemporaryDirectory() as cache:
+            env = dict(os.environ, JAX_COMPILATION_CACHE_DIR=cache, JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS="0")
+            runs = []
+            for _ in range(2):  # the first process fills the cache, the second may read it
+                r = subprocess.run([sys.executable, __file__, "--child", mode], env=env, capture_output=True, text=True)
+                if r.returncode:
+                    print(r.stderr)
+                    return 1
+                runs.append(json.loads(r.stdout.strip().splitlines()[-1]))
+                print(mode, runs[-1], flush=True)
+        out["modes"][mode] = {"first_process": runs[0], "second_process": runs[1]}
+    out["load_after"] = os.getloadavg()
+    a.out.parent.mkdir(parents=True, exist_ok=True)
+    a.out.write_text(json.dumps(out, indent=1) + "\n")
+    print(f"wrote {a.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
