@@ -21,7 +21,7 @@ from .noslip import simulate_noslip
 from .params import PARAM_NAMES, CeltParams
 from .solve import INVALID_KINDS, STATUS, Solution, simulate
 from .state import check_state, constraint_residual, initial_state
-from .sweep import SweepResult, bifurcation, continuation, parameter_map
+from .sweep import SweepResult, bifurcation, continuation, parameter_map, sweep_lanes
 
 __version__ = "0.1.0"
 
@@ -47,6 +47,7 @@ __all__ = [
     "celt_lyapunov",
     "continuation",
     "parameter_map",
+    "sweep_lanes",
     "largest_lyapunov",
     "CONTACT_LAWS",
     "CeltParams",
