@@ -31,6 +31,7 @@ remedy for long and chaotic records (see `gradient_norm_vs_window`, `finite_time
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import time
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -45,6 +46,7 @@ import optimistix as optx
 
 from . import _config  # noqa: F401
 from ._diffrax_adapter import runtime_checks_as_nan
+from ._executable_cache import compiled
 from ._types import Array, State
 from .data import OBSERVABLES, SENSOR_KINDS, MeasuredData, observe, rotation_matrix
 from .model import contact_geometry
@@ -71,6 +73,7 @@ __all__ = [
 ]
 
 OPTIMISERS = ("lm", "gn", "gn-damped", "adam", "lbfgs")
+LSQ_OPTIMISERS = ("lm", "gn", "gn-damped")  # optimistix least squares: `multistart` runs them vmapped
 
 STEPS_PER_SECOND = 2000
 """Default step budget of a fit's solves per second of window (rounded up to whole seconds): a
@@ -604,8 +607,8 @@ def _value_and_jacobian(prob: _Problem, zf):
     return dataclasses.replace(prob, mode="fwd").value_and_jacobian(zf)
 
 
-# The only program that contains the ODE solver is `_value_and_jacobian` (residuals and their
-# forward-mode Jacobian, all records vmapped): compiled once per problem shape and shared by every
+# The only program that contains the ODE solver is the evaluation program (residuals and their
+# forward-mode Jacobian, all records): compiled once per problem shape and shared by every
 # optimiser, the uncertainty, multi-start and profile likelihood. The optimisers' own (small)
 # programs reach it through `jax.pure_callback`, so they never contain the solver and are compiled
 # in about a second, once per (residual length, unknowns, optimiser) for the whole process.
@@ -613,24 +616,48 @@ _CALLS = [0]  # evaluations of (r, J) (reported as FitResult.n_eval)
 _ACTIVE: list = [None]  # the problem the callbacks evaluate (set by `fit`; not thread-safe)
 
 
+def _evaluate(prob: _Problem, zf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(r, J) at zf (n,) or at a batch of unknowns (..., n), by the compiled evaluation program of
+    ``prob``'s shape (one per batch shape), kept in memory and -- with JAX's persistent cache
+    directory set -- on disk across processes (`jaxcelt._executable_cache`). Traced without
+    equinox's error callbacks (save times are checked by `_build`): a failing solve gives NaN."""
+    prob = dataclasses.replace(prob, mode="fwd")
+    dyn, static = eqx.partition(prob, eqx.is_array)
+    leaves, treedef = jax.tree.flatten(dyn)
+    lead, n = zf.shape[:-1], zf.shape[-1]
+    x = jnp.asarray(zf.reshape(-1, n) if lead else zf)
+
+    def f(leaves, x):
+        pr = eqx.combine(jax.tree.unflatten(treedef, leaves), static)
+        return jax.vmap(pr.value_and_jacobian)(x) if lead else pr.value_and_jacobian(x)
+
+    description = repr(jax.tree.structure(prob)) + repr(jax.tree.leaves(static))
+    with runtime_checks_as_nan():
+        exe = compiled("fit-residuals-jacobian", f, (leaves, x), description)
+    r, J = (np.asarray(a) for a in exe(leaves, x))
+    return (r.reshape(*lead, -1), J.reshape(*lead, -1, n)) if lead else (r, J)
+
+
 def _host_vj(zf):
     _CALLS[0] += 1
-    # one input type (a fresh array from numpy) for every caller: the jit cache hits. Traced
-    # without equinox's error callbacks (save times are checked by _build): the program can be
-    # stored in JAX's persistent compilation cache
-    with runtime_checks_as_nan():
-        r, J = _value_and_jacobian(_ACTIVE[0], jnp.asarray(np.asarray(zf, np.float64)))
-    return np.asarray(r), np.asarray(J)
+    # under vmap (multi-start) zf has leading batch axes: every start in one vmapped solve
+    return _evaluate(_ACTIVE[0], np.asarray(zf, np.float64))
 
 
 def _vj(zf: Array, m: int) -> tuple[Array, Array]:
     shapes = (jax.ShapeDtypeStruct((m,), zf.dtype), jax.ShapeDtypeStruct((m, zf.shape[-1]), zf.dtype))
-    return jax.pure_callback(_host_vj, shapes, zf, vmap_method="sequential")
+    # under vmap the callback receives the whole batch (leading axes) and evaluates it at once
+    return jax.pure_callback(_host_vj, shapes, zf, vmap_method="expand_dims")
 
 
 @eqx.filter_jit
 def _vj_jit(zf, m):
     return _vj(zf, m)
+
+
+@eqx.filter_jit
+def _vj_batch_jit(zfs, m):
+    return jax.vmap(lambda z: _vj(z, m))(zfs)
 
 
 def _residual_fn(m: int):
@@ -705,6 +732,25 @@ def _lsq_step(z, state, solver, m):
     done, result = solver.terminate(fn, z, None, {}, state, frozenset())
     # loss at the last accepted iterate
     return z, state, 0.5 * jnp.sum(state.f_info.residual**2), done, result
+
+
+@eqx.filter_jit
+def _lsq_init_batch(zs, solver, m):
+    return eqx.filter_vmap(lambda z: _lsq_init(z, solver, m))(zs)
+
+
+@eqx.filter_jit
+def _lsq_step_batch(zs, states, frozen, solver, m):
+    """One step of every start; a start that has terminated (``frozen``) keeps its iterate and state."""
+
+    def one(z, state, stop):
+        z2, state2, loss, done, result = _lsq_step(z, state, solver, m)
+        keep = lambda a, b: jnp.where(stop, a, b) if eqx.is_array(a) else b  # noqa: E731
+        z2 = jnp.where(stop, z, z2)
+        state2 = jax.tree.map(keep, state, state2, is_leaf=lambda x: x is None)
+        return z2, state2, loss, done, result == optx.RESULTS.successful
+
+    return eqx.filter_vmap(one)(zs, states, frozen)
 
 
 @eqx.filter_jit
@@ -793,35 +839,9 @@ def fit(
     Returns:
         `FitResult`.
     """
-    if optimiser not in OPTIMISERS:
-        raise ValueError(f"fit: optimiser must be one of {OPTIMISERS}, got {optimiser!r}")
-    if isinstance(max_iter, bool) or not isinstance(max_iter, int) or max_iter < 1:
-        raise ValueError(f"fit: max_iter must be a positive int, got {max_iter!r}")
-    free = tuple(free)
-    if max_steps is None:
-        span = max(float(tr.ts[-1] - tr.ts[0]) for tr in data.trajectories) / max(int(windows), 1)
-        max_steps = int(STEPS_PER_SECOND * max(1.0, np.ceil(span)))
-    prob, z = _build(
-        data,
-        params0,
-        free,
-        transforms or {},
-        weights or {},
-        windows,
-        window_states,
-        fit_y0,
-        continuity_weight,
-        "fwd",
-        sim_rtol,
-        sim_atol,
-        max_steps,
-        sensor_rotation,
-        time_offset,
-        fit_rotation,
-        fit_time_offset,
-    )
-    P = len(free)
-    m = prob.n_residuals
+    a = dict(locals())  # every argument: shared with `multistart` (`_prepare`, `_result`)
+    prob, zf = _prepare(data, params0, a)
+    free, P, m = prob.free, len(prob.free), prob.n_residuals
     _ACTIVE[0] = prob
     t_start = time.perf_counter()
 
@@ -832,8 +852,7 @@ def fit(
     loss_hist, par_hist = [], []
     converged = False
     iter_marks = [time.perf_counter()]
-    zf = prob.flatten(z)
-    if optimiser in ("lm", "gn", "gn-damped"):
+    if optimiser in LSQ_OPTIMISERS:
         solver = _lsq_solver(optimiser, rtol, atol)
         state = _lsq_init(zf, solver, m)
         for it in range(max_iter):
@@ -878,37 +897,78 @@ def fit(
             zf = z_new
             if max_time is not None and iter_marks[-1] - t_start > max_time:
                 break
-    loop_time = time.perf_counter() - t_start
+    compile_time, wall = _split_times(iter_marks)
+    # through the callback like the optimisers: called from this thread, the jit cache of
+    # `_value_and_jacobian` misses (measured: the solve was traced and compiled again)
+    r, J = (np.asarray(x) for x in _vj_jit(zf, m))
+    return _result(prob, zf, r, J, a, loss_hist, par_hist, converged, compile_time, wall, t_start)
+
+
+def _prepare(data: MeasuredData, params0: CeltParams, a: dict) -> tuple[_Problem, Array]:
+    """Checks the arguments ``a`` of `fit` and builds the problem; returns it and the flat start z."""
+    if a["optimiser"] not in OPTIMISERS:
+        raise ValueError(f"fit: optimiser must be one of {OPTIMISERS}, got {a['optimiser']!r}")
+    max_iter = a["max_iter"]
+    if isinstance(max_iter, bool) or not isinstance(max_iter, int) or max_iter < 1:
+        raise ValueError(f"fit: max_iter must be a positive int, got {max_iter!r}")
+    windows, max_steps = a["windows"], a["max_steps"]
+    if max_steps is None:
+        span = max(float(tr.ts[-1] - tr.ts[0]) for tr in data.trajectories) / max(int(windows), 1)
+        max_steps = int(STEPS_PER_SECOND * max(1.0, np.ceil(span)))
+    prob, z = _build(
+        data,
+        params0,
+        tuple(a["free"]),
+        a["transforms"] or {},
+        a["weights"] or {},
+        windows,
+        a["window_states"],
+        a["fit_y0"],
+        a["continuity_weight"],
+        "fwd",
+        a["sim_rtol"],
+        a["sim_atol"],
+        max_steps,
+        a["sensor_rotation"],
+        a["time_offset"],
+        a["fit_rotation"],
+        a["fit_time_offset"],
+    )
+    return prob, prob.flatten(z)
+
+
+def _split_times(iter_marks: list[float]) -> tuple[float, float]:
+    """(compile time, run time) from the iteration end times: the first iteration pays for
+    compilation; it is counted as a typical (median) iteration in the run time."""
     iter_times = np.diff(np.asarray(iter_marks))
     typical = float(np.median(iter_times[1:])) if iter_times.size > 1 else 0.0
-    # the first iteration pays for compilation; count it as a typical iteration in the run time
     compile_time = max(float(iter_times[0]) - typical, 0.0) if iter_times.size else 0.0
-    wall = loop_time - compile_time
+    return compile_time, float(iter_marks[-1] - iter_marks[0]) - compile_time
+
+
+def _result(prob, zf, r, Jflat, a, loss_hist, par_hist, converged, compile_time, wall, t_start) -> FitResult:
+    """`FitResult` at the final unknowns ``zf`` with residuals ``r`` and Jacobian ``Jflat`` there."""
+    free, P = prob.free, len(prob.free)
+    zf = jnp.asarray(zf)
+    th = np.asarray(prob.theta(zf[:P]))
+    values = {n: float(th[i]) for i, n in enumerate(free)}
     z = prob.unflatten(zf)
     n_data = int(sum(float(jnp.sum(prob.rec.mask[k])) * OBSERVABLES[k] for k in prob.kinds))
     if prob.rec.ts.shape[1] > 1:  # shared window boundary samples are counted once
-        R, K, _ = prob.rec.ts.shape
         n_data -= int(sum(float(jnp.sum(prob.rec.mask[k][:, 1:, 0])) * OBSERVABLES[k] for k in prob.kinds))
-    if uncertainty:
-        # through the callback like the optimisers: called from this thread, the jit cache of
-        # `_value_and_jacobian` misses (measured: the solve was traced and compiled again)
-        r, Jflat = (np.asarray(a) for a in _vj_jit(zf, m))
-    else:
-        r = np.asarray(_residuals(prob, z)[0])
     nm = prob.n_misfit
     misfit, cont = float(np.sum(r[:nm] ** 2)), float(np.sum(r[nm:] ** 2))
-    loss_hist.append(0.5 * (misfit + cont))
-    par_hist.append(values_of(zf))
+    loss_hist = [*loss_hist, 0.5 * (misfit + cont)]
+    par_hist = [*par_hist, values]
     n_unk = int(zf.size)
-    values = values_of(zf)
-    rv_fit, off_fit = (np.asarray(a) for a in prob.sensor(z))
+    rv_fit, off_fit = (np.asarray(x) for x in prob.sensor(z))
     nuisance: dict[str, Any] = {"rotation_vector": rv_fit.tolist(), "time_offset": off_fit.tolist()}
     stderr = dict.fromkeys(free, np.nan)
     ci = {n: (np.nan, np.nan) for n in free}
     cov = np.full((P, P), np.nan)
     corr = np.full((P, P), np.nan)
     s2 = np.nan
-    if uncertainty:
+    if a["uncertainty"]:
         n_free_states = prob.n_records * len(prob.rec.free_windows)
         dof = max(n_data - (n_unk - 3 * n_free_states), 1)
         s2 = misfit / dof
@@ -934,7 +994,6 @@ def fit(
         for i, nme in enumerate(free):
             stderr[nme] = float(se[i])
             ci[nme] = (values[nme] - 1.96 * float(se[i]), values[nme] + 1.96 * float(se[i]))
-    total = time.perf_counter() - t_start
     return FitResult(
         free=free,
         values=values,
@@ -953,11 +1012,11 @@ def fit(
         param_history=par_hist,
         n_iter=len(loss_hist) - 1,
         converged=bool(converged),
-        optimiser=optimiser,
-        windows=windows,
+        optimiser=a["optimiser"],
+        windows=a["windows"],
         wall_time=wall,
         compile_time=compile_time,
-        total_time=total,
+        total_time=time.perf_counter() - t_start,
         z=z,
         problem=prob,
         nuisance=nuisance,
@@ -1025,19 +1084,41 @@ def fit_staged(data: MeasuredData, params0: CeltParams, spans: Sequence[float], 
 
 # ----------------------------------------------------------------------------- multi-start, profile likelihood
 def multistart(
-    data: MeasuredData, params0: CeltParams, guesses: Sequence[dict[str, float]], **fit_kw
+    data: MeasuredData,
+    params0: CeltParams,
+    guesses: Sequence[dict[str, float]],
+    *,
+    vmapped: bool = True,
+    **fit_kw,
 ) -> tuple[FitResult, dict[str, Any]]:
     """Fits from several initial guesses; returns the best (lowest loss) and a summary.
 
-    Every guess has the same problem shape, so all fits share the compiled programs of the first
-    (one compilation in total); fits run one after another. ``guesses``: dicts of starting values
-    (other parameters from ``params0``). Summary: per fit its start, values, loss, converged; and
-    per parameter the spread (min, max) over the converged fits whose loss is within 1e-6
-    relative of the best (the fits that found the same optimum) and how many did.
+    With a least-squares optimiser (``"lm"``, ``"gn"``, ``"gn-damped"``) and ``vmapped=True`` (the
+    default) every start iterates at once: one vmapped optimiser step per iteration, and the ODE
+    solves of all starts in one vmapped program per iteration; a start that has terminated keeps
+    its iterate while the others go on. ``guesses``: dicts of starting values of free parameters
+    (the others, the problem's fixed values and multiple-shooting window states, from ``params0``);
+    the returned fits share the batch's timings. Otherwise (optax optimisers, ``vmapped=False``)
+    the fits run one after another, sharing one compilation; there a guess may also set fixed
+    parameters. ``fit_kw``: as for `fit` (``callback`` receives the lowest loss over the starts).
+
+    Summary: per fit its start, values, loss, converged; per parameter the spread (min, max) over
+    the converged fits whose loss is within 1e-6 relative of the best (the fits that found the same
+    optimum) and how many did; ``vmapped``, ``compile_time`` and ``wall_time`` [s] of the whole call.
     """
     if not guesses:
         raise ValueError("multistart: 'guesses' is empty")
-    results = [fit(data, params0.replace(**g), **fit_kw) for g in guesses]
+    t0 = time.perf_counter()
+    a = inspect.signature(fit).bind(data, params0, **fit_kw)
+    a.apply_defaults()
+    a = dict(a.arguments)
+    vmapped = bool(vmapped) and a["optimiser"] in LSQ_OPTIMISERS
+    if vmapped:
+        results = _fit_batch(data, params0, guesses, a)
+        compile_time = results[0].compile_time
+    else:
+        results = [fit(data, params0.replace(**g), **fit_kw) for g in guesses]
+        compile_time = results[0].compile_time
     best = min(results, key=lambda r: r.loss if np.isfinite(r.loss) else np.inf)
     same = [r for r in results if r.converged and abs(r.loss - best.loss) <= 1e-6 * abs(best.loss) + 1e-12]
     summary = dict(
@@ -1047,8 +1128,66 @@ def multistart(
         ],
         n_at_best=len(same),
         spread={n: (min(r.values[n] for r in same), max(r.values[n] for r in same)) for n in best.free} if same else {},
+        vmapped=vmapped,
+        compile_time=compile_time,
+        wall_time=time.perf_counter() - t0 - compile_time,
     )
     return best, summary
+
+
+def _fit_batch(
+    data: MeasuredData, params0: CeltParams, guesses: Sequence[dict[str, float]], a: dict
+) -> list[FitResult]:
+    """Least-squares fits from every guess at once (see `multistart`)."""
+    prob, zf0 = _prepare(data, params0, a)
+    free, P, m = prob.free, len(prob.free), prob.n_residuals
+    starts = np.repeat(np.asarray(zf0)[None], len(guesses), axis=0)
+    for i, g in enumerate(guesses):
+        for name, v in g.items():
+            if name not in free:
+                raise ValueError(f"multistart: guess {i} sets {name!r}, which is not a free parameter {free}")
+            j = free.index(name)
+            zj = float(prob.transforms[j].inverse(jnp.asarray(float(v)), prob.theta0[j]))
+            if not np.isfinite(zj):
+                raise ValueError(f"multistart: guess {i}: {name} = {v!r} is outside the range of its transform")
+            starts[i, j] = zj
+    _ACTIVE[0] = prob
+    t_start = time.perf_counter()
+    theta = jax.jit(jax.vmap(prob.theta))
+    S = len(guesses)
+    zs = jnp.asarray(starts)
+    solver = _lsq_solver(a["optimiser"], a["rtol"], a["atol"])
+    states = _lsq_init_batch(zs, solver, m)
+    frozen, converged = np.zeros(S, bool), np.zeros(S, bool)
+    loss_hist: list[list[float]] = [[] for _ in range(S)]
+    par_hist: list[list[dict]] = [[] for _ in range(S)]
+    iter_marks = [time.perf_counter()]
+    for it in range(a["max_iter"]):
+        zs, states, loss, done, ok = _lsq_step_batch(zs, states, jnp.asarray(frozen), solver, m)
+        jax.block_until_ready(zs)
+        iter_marks.append(time.perf_counter())
+        loss, done, ok = np.asarray(loss), np.asarray(done), np.asarray(ok)
+        th = np.asarray(theta(zs[:, :P]))
+        for i in np.flatnonzero(~frozen):
+            loss_hist[i].append(float(loss[i]))
+            par_hist[i].append({n: float(th[i, j]) for j, n in enumerate(free)})
+            if done[i]:
+                frozen[i], converged[i] = True, bool(ok[i])
+        if a["callback"] is not None:
+            last = np.array([h[-1] if h else np.inf for h in loss_hist])
+            b = int(np.argmin(np.where(np.isfinite(last), last, np.inf)))
+            a["callback"](it, float(last[b]), par_hist[b][-1])
+        if frozen.all():
+            break
+        if a["max_time"] is not None and iter_marks[-1] - t_start > a["max_time"]:
+            break
+    compile_time, wall = _split_times(iter_marks)
+    r, J = (np.asarray(x) for x in _vj_batch_jit(zs, m))
+    zs = np.asarray(zs)
+    return [
+        _result(prob, zs[i], r[i], J[i], a, loss_hist[i], par_hist[i], converged[i], compile_time, wall, t_start)
+        for i in range(S)
+    ]
 
 
 def profile_likelihood(

@@ -1,0 +1,133 @@
+"""Compiled programs kept across processes: tracing and XLA compilation both skipped.
+
+JAX's persistent compilation cache (``jax_compilation_cache_dir``) skips XLA's compilation but
+not tracing and lowering, which for a program holding a differentiated ODE solve costs seconds
+in every new process. `compiled` keeps the loaded executable itself, in memory for the process
+and -- when JAX's persistent cache directory is set -- serialised under
+``<jax_compilation_cache_dir>/jaxcelt-executables/`` (``jax.experimental.serialize_executable``).
+
+A stored executable is found by a key that covers everything that shapes the program: the
+caller's description of the function (its static configuration), the shapes and dtypes of the
+arguments, the source of the jaxcelt package, the versions of jax, jaxlib, diffrax, equinox and
+optimistix, the backend, the CPU's instruction-set flags, and the environment variables that
+change tracing or code generation (``EQX_ON_ERROR``, ``XLA_FLAGS``). Editing an installed
+dependency in place without changing its version is not seen: delete the directory then. A file
+that cannot be read (truncated, damaged, another format) is reported with a warning and replaced
+by a fresh compilation; files are written to a temporary name, flushed and renamed. Loading an
+executable runs code from the file: the directory must be the user's own, as JAX's cache is.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import os
+import pickle
+import platform
+import tempfile
+import warnings
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import jax
+
+_MEMORY: dict[str, Any] = {}
+SUBDIR = "jaxcelt-executables"
+
+
+@functools.cache
+def _source_hash() -> str:
+    h = hashlib.sha256()
+    root = Path(__file__).parent
+    for f in sorted(root.rglob("*.py")):
+        h.update(str(f.relative_to(root)).encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+@functools.cache
+def _environment() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    parts = []
+    for pkg in ("jax", "jaxlib", "diffrax", "equinox", "optimistix", "lineax"):
+        try:
+            parts.append(f"{pkg}={version(pkg)}")
+        except PackageNotFoundError:
+            parts.append(f"{pkg}=none")
+    parts.append(f"backend={jax.default_backend()}")
+    parts.append("devices=" + ",".join(sorted({d.device_kind for d in jax.devices()})))
+    parts.append(f"machine={platform.machine()}")
+    try:  # the instruction-set extensions XLA's CPU backend compiles for
+        with open("/proc/cpuinfo") as fh:
+            flags = next((ln for ln in fh if ln.startswith(("flags", "Features"))), "")
+    except OSError:
+        flags = platform.processor()
+    parts.append("cpu=" + hashlib.sha256(flags.encode()).hexdigest())
+    parts.append(f"x64={jax.config.jax_enable_x64}")
+    return ";".join(parts)
+
+
+def cache_dir() -> Path | None:
+    """Directory of the stored executables, or None when JAX's persistent cache is not set."""
+    d = jax.config.jax_compilation_cache_dir
+    return Path(d) / SUBDIR if d else None
+
+
+def _key(name: str, description: str, args: tuple) -> str:
+    shapes = [(tuple(a.shape), str(a.dtype)) for a in jax.tree.leaves(args)]
+    env = [os.environ.get(v, "") for v in ("EQX_ON_ERROR", "XLA_FLAGS")]
+    text = "\n".join([name, description, repr(jax.tree.structure(args)), repr(shapes), repr(env), _environment()])
+    return name + "-" + hashlib.sha256((text + _source_hash()).encode()).hexdigest()[:32]
+
+
+def compiled(name: str, fn: Callable, args: tuple, description: str) -> Callable:
+    """``jax.jit(fn)`` compiled for ``args`` (a tuple of arrays or lists of arrays), from this
+    process's memory, from the directory of stored executables, or compiled now (and stored).
+
+    ``description`` must determine ``fn`` completely apart from the arguments (e.g. the repr of the
+    static part of the problem it closes over): two functions with equal ``name`` and
+    ``description`` are taken to be the same program.
+    """
+    key = _key(name, description, args)
+    exe = _MEMORY.get(key)
+    if exe is not None:
+        return exe
+    from jax.experimental import serialize_executable
+
+    d = cache_dir()
+    path = d / f"{key}.bin" if d is not None else None
+    if path is not None and path.exists():
+        try:
+            payload, in_tree, out_tree = pickle.loads(path.read_bytes())
+            exe = serialize_executable.deserialize_and_load(payload, in_tree, out_tree)
+        except Exception as e:  # truncated, damaged or foreign file: compile again and replace it
+            warnings.warn(
+                f"jaxcelt: stored executable {path} could not be loaded ({type(e).__name__}: {e}); recompiling",
+                RuntimeWarning,
+                stacklevel=2,
+            )
+            exe = None
+    if exe is None:
+        exe = jax.jit(fn).lower(*args).compile()
+        if path is not None:
+            _store(path, exe)
+    _MEMORY[key] = exe
+    return exe
+
+
+def _store(path: Path, exe: Any) -> None:
+    from jax.experimental import serialize_executable
+
+    try:
+        blob = pickle.dumps(serialize_executable.serialize(exe))
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(blob)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except Exception as e:  # an unwritable directory or a program that cannot be serialised
+        warnings.warn(f"jaxcelt: could not store executable {path.name} ({type(e).__name__}: {e})", stacklevel=3)

@@ -1,0 +1,137 @@
+"""Compiled programs stored across processes (`jaxcelt._executable_cache`): a stored executable is
+loaded instead of traced, gives the same result as a fresh compilation, is keyed by what shapes the
+program, and a damaged file is recompiled with a warning instead of crashing."""
+
+import subprocess
+import sys
+import textwrap
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from jaxcelt import _executable_cache as ec
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch):
+    old = jax.config.jax_compilation_cache_dir
+    jax.config.update("jax_compilation_cache_dir", str(tmp_path))
+    monkeypatch.setattr(ec, "_MEMORY", {})
+    yield tmp_path / ec.SUBDIR
+    jax.config.update("jax_compilation_cache_dir", old)
+
+
+def _f(leaves, x):
+    return jnp.sin(x) * leaves[0] + leaves[1]
+
+
+def _args():
+    return ([jnp.asarray(2.0), jnp.arange(3.0)], jnp.linspace(0.0, 1.0, 3))
+
+
+def _traced(monkeypatch) -> list:
+    """Counts the programs lowered by `compiled` (a loaded executable is not lowered)."""
+    calls = []
+    real = jax.jit
+
+    def counting(fn, *a, **k):
+        calls.append(fn)
+        return real(fn, *a, **k)
+
+    monkeypatch.setattr(ec.jax, "jit", counting)
+    return calls
+
+
+def test_stored_executable_is_loaded_not_traced(cache, monkeypatch):
+    traced = _traced(monkeypatch)
+    args = _args()
+    want = np.sin(np.linspace(0.0, 1.0, 3)) * 2.0 + np.arange(3.0)
+    out1 = ec.compiled("t", _f, args, "sin")(*args)
+    assert len(traced) == 1 and len(list(cache.glob("*.bin"))) == 1
+    ec._MEMORY.clear()  # as in a new process
+    out2 = ec.compiled("t", _f, args, "sin")(*args)
+    assert len(traced) == 1  # loaded from the file
+    # the same executable run twice: identical; against numpy's sin to 1e-15 (a few ulp)
+    np.testing.assert_array_equal(np.asarray(out1), np.asarray(out2))
+    np.testing.assert_allclose(np.asarray(out2), want, rtol=0, atol=1e-15)
+
+
+def test_key_covers_description_and_shapes(cache, monkeypatch):
+    traced = _traced(monkeypatch)
+    args = _args()
+    ec.compiled("t", _f, args, "sin")
+    ec.compiled("t", _f, args, "sin, other settings")  # another description: another program
+    longer = ([jnp.asarray(2.0), jnp.arange(4.0)], jnp.linspace(0.0, 1.0, 4))
+    ec.compiled("t", _f, longer, "sin")  # other shapes: another program
+    assert len(traced) == 3 and len(list(cache.glob("*.bin"))) == 3
+
+
+@pytest.mark.parametrize("damage", ["truncate", "garbage", "empty"])
+def test_damaged_file_is_recompiled_with_a_warning(cache, monkeypatch, damage):
+    args = _args()
+    ec.compiled("t", _f, args, "sin")
+    (path,) = cache.glob("*.bin")
+    blob = path.read_bytes()
+    path.write_bytes({"truncate": blob[: len(blob) // 2], "garbage": b"not a pickle" * 10, "empty": b""}[damage])
+    ec._MEMORY.clear()
+    traced = _traced(monkeypatch)
+    with pytest.warns(RuntimeWarning, match="could not be loaded"):
+        exe = ec.compiled("t", _f, args, "sin")
+    assert len(traced) == 1
+    np.testing.assert_allclose(np.asarray(exe(*args)), np.sin(np.linspace(0, 1, 3)) * 2 + np.arange(3.0), atol=1e-15)
+    assert path.read_bytes() != b"" and len(path.read_bytes()) > 1000  # replaced by a good file
+    ec._MEMORY.clear()
+    ec.compiled("t", _f, args, "sin")  # and that file loads
+    assert len(traced) == 1
+
+
+def test_no_directory_no_files(tmp_path, monkeypatch):
+    old = jax.config.jax_compilation_cache_dir
+    jax.config.update("jax_compilation_cache_dir", None)
+    monkeypatch.setattr(ec, "_MEMORY", {})
+    try:
+        assert ec.cache_dir() is None
+        args = _args()
+        a = ec.compiled("t", _f, args, "sin")
+        assert ec.compiled("t", _f, args, "sin") is a  # kept in memory
+    finally:
+        jax.config.update("jax_compilation_cache_dir", old)
+
+
+def test_second_process_loads_the_fit_program(tmp_path):
+    """The fit's evaluation program, stored by one process, is loaded by the next: its (r, J) at the
+    start equal the first process's to 1e-12 relative (the same executable; the tolerance only
+    covers printing) and the second process lowers no evaluation program."""
+    script = textwrap.dedent(
+        f"""
+        import json, sys
+        import jax
+        jax.config.update("jax_compilation_cache_dir", {str(tmp_path)!r})
+        import numpy as np
+        import jaxcelt as jc
+        from jaxcelt import _executable_cache as ec
+        from jaxcelt.data import generate_data
+        F = sys.modules["jaxcelt.fit"]
+        p = jc.CeltParams.paper()
+        y0 = jc.initial_state(p, omega=(0.0, 0.0, 5.0), n=(0.17, 0.0, 0.985), normalize=True)
+        data = generate_data(p, y0, 0.1, rate=50, kinds=("omega",))
+        prob, z = F._build(data, p, ("mu", "k_r"), {{}}, {{}}, 1, "optimise", False, 1.0, "fwd", 1e-8, 1e-10, 2000)
+        lowered = []
+        real = ec.jax.jit
+        ec.jax.jit = lambda fn, *a, **k: (lowered.append(1), real(fn, *a, **k))[1]
+        r, J = F._evaluate(prob, np.asarray(prob.flatten(z)) + 0.1)
+        print(json.dumps(dict(lowered=len(lowered), r=r.tolist(), J=J.ravel().tolist())))
+        """
+    )
+    import json
+
+    outs = []
+    for _ in range(2):
+        p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=600)
+        assert p.returncode == 0, p.stderr[-3000:]
+        outs.append(json.loads(p.stdout.strip().splitlines()[-1]))
+    assert outs[0]["lowered"] == 1 and outs[1]["lowered"] == 0
+    for k in ("r", "J"):
+        np.testing.assert_allclose(outs[1][k], outs[0][k], rtol=1e-12, atol=1e-300)
