@@ -31,9 +31,13 @@ remedy for long and chaotic records (see `gradient_norm_vs_window`, `finite_time
 from __future__ import annotations
 
 import dataclasses
+import functools
 import inspect
+import os
+import threading
 import time
 from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import diffrax
@@ -68,6 +72,7 @@ __all__ = [
     "finite_time_lyapunov",
     "gradient_norm_vs_window",
     "multistart",
+    "random_guesses",
     "profile_likelihood",
     "fit_staged",
 ]
@@ -614,13 +619,70 @@ def _value_and_jacobian(prob: _Problem, zf):
 # in about a second, once per (residual length, unknowns, optimiser) for the whole process.
 _CALLS = [0]  # evaluations of (r, J) (reported as FitResult.n_eval)
 _ACTIVE: list = [None]  # the problem the callbacks evaluate (set by `fit`; not thread-safe)
+_COMPILE_LOCK = threading.Lock()
+
+
+def _cpu_workers() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+@functools.cache
+def _record_pool(workers: int) -> ThreadPoolExecutor:
+    return ThreadPoolExecutor(max_workers=workers, thread_name_prefix="jaxcelt-fit")
+
+
+def _one_record(prob: _Problem, i: int) -> tuple[_Problem, np.ndarray, np.ndarray]:
+    """Record ``i`` as a problem of its own, the columns of its unknowns in the flat vector and the
+    rows of its residuals (misfit block, then penalty block) in the whole problem's residuals."""
+    rec, R = prob.rec, prob.n_records
+    cut = lambda a: a[i : i + 1]  # noqa: E731
+    sub_rec = dataclasses.replace(
+        rec,
+        ts=cut(rec.ts),
+        obs=jax.tree.map(cut, rec.obs),
+        mask=jax.tree.map(cut, rec.mask),
+        inv_sigma=jax.tree.map(cut, rec.inv_sigma),
+        fixed_states=cut(rec.fixed_states),
+        omega_pi=cut(rec.omega_pi),
+        q_pi=cut(rec.q_pi),
+        offset0=cut(rec.offset0),
+    )
+    sub = dataclasses.replace(prob, rec=sub_rec)
+    P, nr, k13 = len(prob.free), 3 * prob.fit_rotation, 13 * len(rec.free_windows)
+    no = R * prob.fit_time_offset
+    cols = np.concatenate(
+        [np.arange(P + nr), [P + nr + i] if prob.fit_time_offset else [], P + nr + no + i * k13 + np.arange(k13)]
+    ).astype(int)
+    lm, lp = sub.n_misfit, sub.n_residuals - sub.n_misfit
+    rows = np.concatenate([i * lm + np.arange(lm), R * lm + i * lp + np.arange(lp)]).astype(int)
+    return sub, cols, rows
 
 
 def _evaluate(prob: _Problem, zf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(r, J) at zf (n,) or at a batch of unknowns (..., n), by the compiled evaluation program of
-    ``prob``'s shape (one per batch shape), kept in memory and -- with JAX's persistent cache
-    directory set -- on disk across processes (`jaxcelt._executable_cache`). Traced without
-    equinox's error callbacks (save times are checked by `_build`): a failing solve gives NaN."""
+    """(r, J) at zf (n,) or at a batch of unknowns (..., n). On a CPU with several cores, records
+    are evaluated in parallel threads, each by the one-record program (the records share its
+    shapes); otherwise all records by one program (`jax.lax.map`)."""
+    R, workers = prob.n_records, min(prob.n_records, _cpu_workers())
+    if R == 1 or workers == 1 or jax.default_backend() != "cpu":
+        return _evaluate_program(prob, zf)
+    parts = [_one_record(prob, i) for i in range(R)]
+    outs = list(_record_pool(workers).map(lambda part: _evaluate_program(part[0], zf[..., part[1]]), parts))
+    r = np.empty((*zf.shape[:-1], prob.n_residuals))
+    J = np.zeros((*zf.shape[:-1], prob.n_residuals, zf.shape[-1]))
+    for (_, cols, rows), (ri, Ji) in zip(parts, outs, strict=True):
+        r[..., rows] = ri
+        J[..., rows[:, None], cols[None, :]] = Ji
+    return r, J
+
+
+def _evaluate_program(prob: _Problem, zf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(r, J) by the compiled evaluation program of ``prob``'s shape (one per batch shape), kept
+    in memory and -- with JAX's persistent cache directory set -- on disk across processes
+    (`jaxcelt._executable_cache`). Traced without equinox's error callbacks (save times are
+    checked by `_build`): a failing solve gives NaN."""
     prob = dataclasses.replace(prob, mode="fwd")
     dyn, static = eqx.partition(prob, eqx.is_array)
     leaves, treedef = jax.tree.flatten(dyn)
@@ -632,7 +694,7 @@ def _evaluate(prob: _Problem, zf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return jax.vmap(pr.value_and_jacobian)(x) if lead else pr.value_and_jacobian(x)
 
     description = repr(jax.tree.structure(prob)) + repr(jax.tree.leaves(static))
-    with runtime_checks_as_nan():
+    with _COMPILE_LOCK, runtime_checks_as_nan():  # one thread traces (the context swaps a global)
         exe = compiled("fit-residuals-jacobian", f, (leaves, x), description)
     r, J = (np.asarray(a) for a in exe(leaves, x))
     return (r.reshape(*lead, -1), J.reshape(*lead, -1, n)) if lead else (r, J)
@@ -1133,6 +1195,39 @@ def multistart(
         wall_time=time.perf_counter() - t0 - compile_time,
     )
     return best, summary
+
+
+def random_guesses(
+    params0: CeltParams,
+    n: int,
+    *,
+    free: Sequence[str] = ("mu", "k_r", "b_Ts", "m_Ts"),
+    transforms: dict[str, Any] | None = None,
+    spread: float = float(np.log(2.0)),
+    seed: int = 0,
+) -> list[dict[str, float]]:
+    """``n`` starting guesses for `multistart`: the start itself (``{}``) and ``n - 1`` guesses with
+    the unknown coordinates z of the free parameters drawn uniformly in [-spread, spread] (seeded),
+    i.e. within a factor e^spread (default 2) of ``params0`` for positive parameters, and inside
+    the range of a `Bounded` one."""
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise ValueError(f"random_guesses: n must be a positive int, got {n!r}")
+    if not (np.isfinite(spread) and spread > 0):
+        raise ValueError(f"random_guesses: spread must be positive, got {spread!r}")
+    transforms = transforms or {}
+    for name in free:
+        if name not in PARAM_NAMES or name in _NOT_FREE:
+            raise ValueError(f"random_guesses: {name!r} is not a parameter that can be fitted")
+    rng = np.random.default_rng(seed)
+    out: list[dict[str, float]] = [{}]
+    for _ in range(n - 1):
+        g = {}
+        for name in free:
+            tr = transforms.get(name, DEFAULT_TRANSFORMS.get(name, Positive()))
+            th0 = jnp.asarray(float(getattr(params0, name)))
+            g[name] = float(tr.forward(jnp.asarray(rng.uniform(-spread, spread)), th0))
+        out.append(g)
+    return out
 
 
 def _fit_batch(

@@ -115,6 +115,28 @@ def test_vmapped_multistart_equals_sequential_fits(short_imu):
         F.multistart(data, PAPER, [{"g": 9.0}], free=FREE)
 
 
+def test_records_in_parallel_equal_one_program(monkeypatch):
+    """On a multi-core CPU each record is evaluated by the one-record program in its own thread and
+    the pieces are put back in place: (r, J) equal the all-records program's to 1e-8 relative (two
+    compiled programs of the same solves at rtol 1e-10; a misplaced row or column is an O(1) error).
+    Exercised with every kind of unknown: parameters, sensor rotation, per-record time offsets and
+    optimised window states (two records, two windows each), also batched as in `multistart`."""
+    y0s = [_start(TRUE), jc.initial_state(TRUE, omega=(0.0, 0.0, -3.0), n=(0.1, 0.0, np.sqrt(0.99)))]
+    data = generate_data(TRUE, y0s, 0.2, rate=50, kinds=("omega", "accel"), sensor_rotation=[0.05, 0.0, 0.1])
+    prob, z = F._build(data, PAPER, FREE, {}, {}, 2, "optimise", True, 1e4, "fwd", 1e-10, 1e-12, 4000,
+                       None, [0.01, -0.02], True, True)  # fmt: skip
+    zf = np.asarray(prob.flatten(z))
+    zs = zf + 0.01 * np.random.default_rng(1).standard_normal((2, zf.size))
+    monkeypatch.setattr(F, "_cpu_workers", lambda: 2)
+    for x in (zs[0], zs):
+        r1, J1 = F._evaluate(prob, x)
+        r0, J0 = F._evaluate_program(prob, x)
+        assert r1.shape == r0.shape and J1.shape == J0.shape
+        assert np.linalg.norm(r1 - r0) <= 1e-8 * np.linalg.norm(r0)
+        assert np.linalg.norm(J1 - J0) <= 1e-8 * np.linalg.norm(J0)
+        assert np.count_nonzero(J0) == np.count_nonzero(J1)
+
+
 def test_cli_fit(tmp_path, short_imu, capsys):
     from jaxcelt.cli import main
 
@@ -129,6 +151,28 @@ def test_cli_fit(tmp_path, short_imu, capsys):
     with pytest.raises(SystemExit) as e:  # one error line naming the file (tests/test_cli.py checks the format)
         main(["fit", str(tmp_path / "missing.npz")])
     assert e.value.code == 2
+    # multi-start from the command line: the guess and one random start, vmapped
+    rc = main(["fit", str(path), "--starts", "2", "--max-iter", "3", "--no-plot", "--quiet", "--out", str(tmp_path / "m")])
+    ms = json.loads((tmp_path / "m" / "fit.json").read_text())["multistart"]
+    assert rc == 0 and ms["vmapped"] and len(ms["fits"]) == 2 and ms["fits"][0]["start"] == {}
+    assert set(ms["fits"][1]["start"]) == set(FREE)
+    assert "starts reached the best loss" in capsys.readouterr().out
+    with pytest.raises(SystemExit) as e:
+        main(["fit", str(path), "--starts", "2", "--optimiser", "adam"])
+    assert e.value.code == 2 and "--starts" in capsys.readouterr().err
+
+
+def test_random_guesses_inside_ranges():
+    g = F.random_guesses(PAPER, 50, spread=float(np.log(2.0)), seed=1)
+    assert g[0] == {} and len(g) == 50 and g[1] != g[2]
+    for n in ("mu", "k_r", "b_Ts"):  # Positive: within a factor 2
+        r = np.array([x[n] / float(getattr(PAPER, n)) for x in g[1:]])
+        assert r.min() >= 0.5 - 1e-12 and r.max() <= 2.0 + 1e-12 and r.max() / r.min() > 2.0
+    m = np.array([x["m_Ts"] for x in g[1:]])
+    assert 0.0 < m.min() and m.max() < 2.0  # Bounded(0, 2)
+    assert F.random_guesses(PAPER, 3, seed=1) == F.random_guesses(PAPER, 3, seed=1)
+    with pytest.raises(ValueError, match="n must be"):
+        F.random_guesses(PAPER, 0)
 
 
 def test_fit_argument_errors(short_imu):

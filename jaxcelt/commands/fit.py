@@ -71,6 +71,10 @@ def register(sub) -> None:
                    help="also fit each record's time offset (the base's phase at the record's t = 0)")  # fmt: skip
     p.add_argument("--spans", type=floats_list, default=None, metavar="S1,S2,...",
                    help="fit the first S1 seconds of every record, then S2, ... (jaxcelt.fit.fit_staged)")  # fmt: skip
+    p.add_argument("--starts", type=positive_int, default=1,
+                   help="fit from this many starts at once (vmapped LM): the guess and starts drawn within a "
+                   "factor 2 of it (jaxcelt.fit.random_guesses); the best fit and the spread are reported")  # fmt: skip
+    p.add_argument("--seed", type=int, default=0, help="seed of the random starts")
     p.add_argument("--max-iter", type=positive_int, default=100)
     p.add_argument("--learning-rate", type=positive_float, default=0.02, help="Adam step size")
     p.add_argument("--out", type=Path, default=Path("out/fit"), help="output directory (fit.json, fit.png)")
@@ -84,7 +88,7 @@ def run(args) -> int:
 
     import jaxcelt as jc
     from jaxcelt.data import MeasuredData, load_csv, load_data
-    from jaxcelt.fit import fit, fit_staged
+    from jaxcelt.fit import LSQ_OPTIMISERS, fit, fit_staged, multistart, random_guesses
 
     # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2)
     params0 = jc.CeltParams.paper(**overrides(args.set))
@@ -108,6 +112,11 @@ def run(args) -> int:
     except argparse.ArgumentTypeError as e:
         raise UsageError(f"argument --guess: {e}") from None
     params0 = jc.CeltParams.paper(**overrides(list(args.set) + guess))
+    if args.starts > 1 and args.spans is not None:
+        raise UsageError("argument --starts: cannot be combined with --spans")
+    if args.starts > 1 and args.optimiser not in LSQ_OPTIMISERS:
+        raise UsageError(f"argument --starts: needs a least-squares optimiser {LSQ_OPTIMISERS}, not {args.optimiser!r}")
+    summary = None
     bar = tqdm(total=args.max_iter, disable=args.quiet, desc=f"fit ({args.optimiser})", unit="it")
 
     def progress(it, loss, values):
@@ -116,10 +125,7 @@ def run(args) -> int:
 
     try:
         kw = dict(fit_rotation=args.fit_rotation, fit_time_offset=args.fit_time_offset)
-        res = (fit if args.spans is None else lambda d, p, **k: fit_staged(d, p, args.spans, **k))(
-            data,
-            params0,
-            **kw,
+        kw |= dict(
             free=tuple(args.free),
             optimiser=args.optimiser,
             windows=args.windows,
@@ -129,14 +135,30 @@ def run(args) -> int:
             learning_rate=args.learning_rate,
             callback=progress,
         )
+        if args.starts > 1:
+            guesses = random_guesses(params0, args.starts, free=tuple(args.free), seed=args.seed)
+            res, summary = multistart(data, params0, guesses, **kw)
+        elif args.spans is not None:
+            res = fit_staged(data, params0, args.spans, **kw)
+        else:
+            res = fit(data, params0, **kw)
     finally:
         bar.close()
     print(res.summary())
+    if summary is not None:
+        print(f"{summary['n_at_best']} of {args.starts} starts reached the best loss; spread over them:")
+        for n, (lo, hi) in summary["spread"].items():
+            print(f"  {n:>8s} in [{lo:.6g}, {hi:.6g}]")
     args.out.mkdir(parents=True, exist_ok=True)
     from jaxcelt.versions import versions
 
     (args.out / "fit.json").write_text(
-        json.dumps(res.to_dict() | {"data": [str(p) for p in args.data], "versions": versions()}, indent=1)
+        json.dumps(
+            res.to_dict()
+            | {"data": [str(p) for p in args.data], "versions": versions()}
+            | ({"multistart": summary} if summary is not None else {}),
+            indent=1,
+        )
     )
     print(f"wrote {args.out / 'fit.json'}")
     if not args.no_plot:
