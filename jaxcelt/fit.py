@@ -1150,19 +1150,22 @@ def multistart(
     params0: CeltParams,
     guesses: Sequence[dict[str, float]],
     *,
-    vmapped: bool = True,
+    vmapped: bool | None = None,
     **fit_kw,
 ) -> tuple[FitResult, dict[str, Any]]:
     """Fits from several initial guesses; returns the best (lowest loss) and a summary.
 
-    With a least-squares optimiser (``"lm"``, ``"gn"``, ``"gn-damped"``) and ``vmapped=True`` (the
-    default) every start iterates at once: one vmapped optimiser step per iteration, and the ODE
-    solves of all starts in one vmapped program per iteration; a start that has terminated keeps
-    its iterate while the others go on. ``guesses``: dicts of starting values of free parameters
-    (the others, the problem's fixed values and multiple-shooting window states, from ``params0``);
-    the returned fits share the batch's timings. Otherwise (optax optimisers, ``vmapped=False``)
-    the fits run one after another, sharing one compilation; there a guess may also set fixed
-    parameters. ``fit_kw``: as for `fit` (``callback`` receives the lowest loss over the starts).
+    With a least-squares optimiser (``"lm"``, ``"gn"``, ``"gn-damped"``) and ``vmapped=True`` every
+    start iterates at once: one vmapped optimiser step per iteration, and the ODE solves of all
+    starts in one vmapped program per iteration; a start that has terminated keeps its iterate
+    while the others go on. ``guesses``: dicts of starting values of free parameters (the others,
+    the problem's fixed values and multiple-shooting window states, from ``params0``); the returned
+    fits share the batch's timings. Otherwise (``vmapped=False``, optax optimisers) the fits run one
+    after another, sharing one compilation; there a guess may also set fixed parameters. Default
+    (None): vmapped on an accelerator, one after another on the CPU, where a vmapped adaptive solve
+    steps every start until the stiffest is done (measured 2x slower for 8 starts on 2 cores,
+    ``benchmarks/bench_multistart.py``). ``fit_kw``: as for `fit` (``callback`` receives the
+    lowest loss over the starts).
 
     Summary: per fit its start, values, loss, converged; per parameter the spread (min, max) over
     the converged fits whose loss is within 1e-6 relative of the best (the fits that found the same
@@ -1174,6 +1177,8 @@ def multistart(
     a = inspect.signature(fit).bind(data, params0, **fit_kw)
     a.apply_defaults()
     a = dict(a.arguments)
+    if vmapped is None:
+        vmapped = jax.default_backend() != "cpu"
     vmapped = bool(vmapped) and a["optimiser"] in LSQ_OPTIMISERS
     if vmapped:
         results = _fit_batch(data, params0, guesses, a)

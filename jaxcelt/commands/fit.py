@@ -72,8 +72,9 @@ def register(sub) -> None:
     p.add_argument("--spans", type=floats_list, default=None, metavar="S1,S2,...",
                    help="fit the first S1 seconds of every record, then S2, ... (jaxcelt.fit.fit_staged)")  # fmt: skip
     p.add_argument("--starts", type=positive_int, default=1,
-                   help="fit from this many starts at once (vmapped LM): the guess and starts drawn within a "
-                   "factor 2 of it (jaxcelt.fit.random_guesses); the best fit and the spread are reported")  # fmt: skip
+                   help="fit from this many starts (jaxcelt.fit.multistart: vmapped on a GPU): the guess and "
+                   "starts drawn within a factor 2 of it (jaxcelt.fit.random_guesses); reports the best fit and "
+                   "the spread")  # fmt: skip
     p.add_argument("--seed", type=int, default=0, help="seed of the random starts")
     p.add_argument("--max-iter", type=positive_int, default=100)
     p.add_argument("--learning-rate", type=positive_float, default=0.02, help="Adam step size")
