@@ -120,6 +120,7 @@ def compiled(name: str, fn: Callable, args: tuple, description: str) -> Callable
 def _store(path: Path, exe: Any) -> None:
     from jax.experimental import serialize_executable
 
+    tmp = None
     try:
         blob = pickle.dumps(serialize_executable.serialize(exe))
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -129,5 +130,9 @@ def _store(path: Path, exe: Any) -> None:
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, path)
+        tmp = None
     except Exception as e:  # an unwritable directory or a program that cannot be serialised
         warnings.warn(f"jaxcelt: could not store executable {path.name} ({type(e).__name__}: {e})", stacklevel=3)
+    finally:
+        if tmp is not None and os.path.exists(tmp):
+            os.remove(tmp)

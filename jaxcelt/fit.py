@@ -400,6 +400,8 @@ class FitResult:
     problem: Any = None
     nuisance: dict[str, Any] = dataclasses.field(default_factory=dict)
     """sensor rotation vector [rad] and time offsets [s] (given or fitted; ``*_stderr`` when fitted)"""
+    stages: list[dict[str, Any]] = dataclasses.field(default_factory=list)
+    """`fit_staged`: per stage its span [s], iterations, loss, converged, compile and run time [s]"""
 
     def relative_error(self, true: dict[str, float] | CeltParams) -> dict[str, float]:
         """|fitted - true| / |true| per free parameter."""
@@ -453,6 +455,7 @@ class FitResult:
             compile_time=self.compile_time,
             total_time=self.total_time,
             nuisance=self.nuisance,
+            stages=self.stages,
         )
 
 
@@ -1125,22 +1128,29 @@ def fit_staged(data: MeasuredData, params0: CeltParams, spans: Sequence[float], 
     started from the last one's parameters, release states (``fit_y0``), sensor rotation and time
     offsets. Over a short span the loss is nearly quadratic in a roughly known release and in the
     offsets, which over the whole record would trap the fit in a local minimum (measured in
-    ``scripts/fit_sensor_study.py``). Returns the last fit (make the last span cover the records)."""
+    ``scripts/fit_sensor_study.py``). Returns the last fit (make the last span cover the records),
+    with every stage's iterations, loss and times in ``stages``."""
     if not spans or any(not (s > 0) for s in spans):
         raise ValueError(f"fit_staged: spans must be positive durations [s], got {spans!r}")
     kw = dict(fit_kw)
     p, res = params0, None
     y0s = [tr.y0 for tr in data.trajectories]
+    stages: list[dict[str, Any]] = []
     for span in spans:
         d = _truncate(data, float(span))
         d = MeasuredData(tuple(dataclasses.replace(tr, y0=y) for tr, y in zip(d.trajectories, y0s)), d.meta)
         res = fit(d, p, **kw)
+        stages.append(
+            dict(span=float(span), n_iter=res.n_iter, loss=res.loss, converged=res.converged,
+                 compile_time=res.compile_time, wall_time=res.wall_time)
+        )  # fmt: skip
         p = res.params
         kw["sensor_rotation"] = res.nuisance["rotation_vector"]
         kw["time_offset"] = res.nuisance["time_offset"]
         if kw.get("fit_y0"):
             states = np.asarray(res.z["states"])[:, 0] * STATE_SCALE
             y0s = [np.asarray(project_state(jnp.asarray(s), p)) for s in states]
+    res.stages = stages
     return res
 
 

@@ -315,3 +315,22 @@ def test_sensor_study_numbers_from_json():
     quotes += [f"s² = {d['whole_record_fit_seed0']['s2']:.0f}", f"compilation {s['run_s_median']:.1f} s"]
     for q in quotes:
         assert q in text, q
+
+
+def test_fit_benchmark_table_from_json():
+    """The optimiser x problem table in docs/identification.md is the one benchmarks/bench_fit.py
+    prints from docs/fit/bench_fit.json, and the multi-start numbers come from docs/fit/multistart.json."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("bench_fit", Path(__file__).parents[1] / "benchmarks" / "bench_fit.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    text = _text("docs/identification.md")
+    for line in bench.table(_json("docs/fit/bench_fit.json")["rows"]).splitlines():
+        assert line in text, line
+    ms = {r["mode"]: r for r in _json("docs/fit/multistart.json")["rows"]}
+    flat = " ".join(text.split())
+    for mode in ("vmapped", "sequential"):
+        r = ms[mode]
+        assert f"{mode}: compile {r['compile_s']:.1f} s, run {r['run_s']:.1f} s" in flat, mode
+    assert f"{ms['vmapped']['n_at_best']} of {ms['vmapped']['n_starts']} starts" in flat

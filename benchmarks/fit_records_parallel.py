@@ -1,0 +1,77 @@
+"""One evaluation of a fit's residuals and Jacobian: records in parallel threads against one program
+(writes docs/fit/records_parallel.json).
+
+The problem of ``benchmarks/bench_fit.py`` (two 1 s gyro records, 4 parameters) at the paper's
+values: (r, J) by ``jaxcelt.fit._evaluate`` (on a multi-core CPU: each record by the one-record
+program in its own thread), by the all-records program (`jax.lax.map` over the records,
+``_evaluate_program``), and by the one-record program called for each record in turn. Compiled
+first; best of ``--reps`` warm calls each; the results of the modes are compared.
+
+    python benchmarks/fit_records_parallel.py [--reps 10] [--out docs/fit/records_parallel.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--reps", type=int, default=10)
+    ap.add_argument("--out", type=Path, default=Path("docs/fit/records_parallel.json"))
+    a = ap.parse_args(argv)
+    import numpy as np
+
+    import jaxcelt as jc
+    from jaxcelt.data import generate_data
+    from jaxcelt.versions import versions
+
+    F = sys.modules["jaxcelt.fit"]
+    paper = jc.CeltParams.paper()
+    true = paper.replace(mu=0.2241 * 1.4, k_r=0.4345 * 0.6, b_Ts=0.5305 * 1.5, m_Ts=0.8161 * 1.35)
+
+    def start(spin, tilt):
+        t = np.radians(tilt)
+        return jc.initial_state(true, omega=(0.0, 0.0, spin), n=(np.sin(t), 0.0, np.cos(t)))
+
+    data = generate_data(true, [start(5.0, 10.0), start(-3.0, 6.0)], 1.0, rate=100, kinds=("omega",))
+    prob, z = F._build(data, paper, ("mu", "k_r", "b_Ts", "m_Ts"), {}, {}, 1, "optimise", False, 1e4, "fwd",
+                       1e-8, 1e-10, 2000)  # fmt: skip
+    zf = np.asarray(prob.flatten(z))
+    parts = [F._one_record(prob, i) for i in range(prob.n_records)]
+    modes = {
+        "threads": lambda: F._evaluate(prob, zf),
+        "one_program_lax_map": lambda: F._evaluate_program(prob, zf),
+        "records_in_turn": lambda: [F._evaluate_program(p, zf[..., c]) for p, c, _ in parts],
+    }
+    out = dict(versions=versions(), cpus=F._cpu_workers(), load_before=os.getloadavg(), reps=a.reps, best_s={})
+    results = {}
+    for name, f in modes.items():
+        results[name] = f()  # compile
+        ts = []
+        for _ in range(a.reps):
+            t = time.perf_counter()
+            f()
+            ts.append(time.perf_counter() - t)
+        out["best_s"][name] = min(ts)
+        print(name, min(ts), flush=True)
+    r0, J0 = results["one_program_lax_map"]
+    r1, J1 = results["threads"]
+    out["threads_vs_one_program_rel_diff"] = dict(
+        r=float(np.linalg.norm(r1 - r0) / np.linalg.norm(r0)), J=float(np.linalg.norm(J1 - J0) / np.linalg.norm(J0))
+    )
+    out["speedup_threads_over_one_program"] = out["best_s"]["one_program_lax_map"] / out["best_s"]["threads"]
+    out["load_after"] = os.getloadavg()
+    a.out.parent.mkdir(parents=True, exist_ok=True)
+    a.out.write_text(json.dumps(out, indent=1))
+    print(json.dumps(out, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
