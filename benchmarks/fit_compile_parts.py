@@ -4,8 +4,10 @@ The problem of ``benchmarks/bench_fit.py`` (two 1 s gyro records, 4 parameters).
 program (`jaxcelt.fit._value_and_jacobian`: residuals and forward-mode Jacobian) it times tracing +
 lowering and XLA compilation apart, counts the host callbacks in it, and -- in two fresh processes
 sharing an empty persistent compilation cache -- whether the second process loads it from the cache.
-Both with equinox's runtime checks as host callbacks (equinox's default) and traced inside
-`jaxcelt._diffrax_adapter.runtime_checks_as_nan` (what `jaxcelt.fit` does).
+Modes: ``raise``, equinox's runtime checks as host callbacks (equinox's default); ``nan``, traced
+inside `jaxcelt._diffrax_adapter.runtime_checks_as_nan`; ``nan-options``, that and compiled with
+``jaxcelt.fit._COMPILER_OPTIONS["cpu"]`` (what `jaxcelt.fit` does on a CPU). Also: the best of 10
+warm runs of the compiled program (the two records, all-records program).
 
     python benchmarks/fit_compile_parts.py [--out docs/fit/compile_parts.json]
 """
@@ -42,17 +44,24 @@ def child(mode: str) -> dict:
     prob, z = F._build(data, paper, ("mu", "k_r", "b_Ts", "m_Ts"), {}, {}, 1, "optimise", False, 1e4, "fwd",
                        1e-8, 1e-10, 2000)  # fmt: skip
     zf = prob.flatten(z)
-    ctx = runtime_checks_as_nan() if mode == "nan" else contextlib.nullcontext()
+    ctx = runtime_checks_as_nan() if mode != "raise" else contextlib.nullcontext()
     with ctx:
         t0 = time.perf_counter()
         low = F._value_and_jacobian.lower(prob, zf)
         t1 = time.perf_counter()
-    low.compile()
+    exe = low.compile(compiler_options=F._COMPILER_OPTIONS["cpu"]) if mode == "nan-options" else low.compile()
     t2 = time.perf_counter()
+    exe(prob, zf)[1].block_until_ready()
+    runs = []
+    for _ in range(10):
+        t = time.perf_counter()
+        exe(prob, zf)[1].block_until_ready()
+        runs.append(time.perf_counter() - t)
     return {
         "trace_lower_s": round(t1 - t0, 3),
         "compile_s": round(t2 - t1, 3),
         "host_callbacks": low.as_text().count("callback"),
+        "run_best_of_10_s": round(min(runs), 4),
     }
 
 
@@ -67,7 +76,7 @@ def main() -> int:
     from jaxcelt.versions import versions
 
     out = {"versions": versions(), "cpu_count": os.cpu_count(), "load_before": os.getloadavg(), "modes": {}}
-    for mode in ("raise", "nan"):
+    for mode in ("raise", "nan", "nan-options"):
         with tempfile.TemporaryDirectory() as cache:
             env = dict(os.environ, JAX_COMPILATION_CACHE_DIR=cache, JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS="0")
             runs = []

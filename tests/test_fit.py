@@ -112,7 +112,7 @@ def test_vmapped_multistart_equals_sequential_fits(short_imu):
     assert np.isfinite(best.stderr["mu"]) and best.loss == min(f["loss"] for f in summ["fits"])
     assert summ["fits"][1]["values"] != summ["fits"][0]["values"]  # each lane's own result
     with pytest.raises(ValueError, match="not a free parameter"):
-        F.multistart(data, PAPER, [{"g": 9.0}], free=FREE)
+        F.multistart(data, PAPER, [{"g": 9.0}], free=FREE, vmapped=True)
 
 
 def test_records_in_parallel_equal_one_program(monkeypatch):
