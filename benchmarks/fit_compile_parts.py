@@ -6,7 +6,8 @@ lowering and XLA compilation apart, counts the host callbacks in it, and -- in t
 sharing an empty persistent compilation cache -- whether the second process loads it from the cache.
 Modes: ``raise``, equinox's runtime checks as host callbacks (equinox's default); ``nan``, traced
 inside `jaxcelt._diffrax_adapter.runtime_checks_as_nan`; ``nan-options``, that and compiled with
-``jaxcelt.fit._COMPILER_OPTIONS["cpu"]`` (what `jaxcelt.fit` does on a CPU). Also: the best of 10
+XLA's CPU fusion emitters off (``FUSION_EMITTERS_OFF``; an evaluation, not what `jaxcelt.fit` does:
+see docs/identification.md). Also: the best of 10
 warm runs of the compiled program (the two records, all-records program).
 
     python benchmarks/fit_compile_parts.py [--out docs/fit/compile_parts.json]
@@ -23,6 +24,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+FUSION_EMITTERS_OFF = {"xla_cpu_use_fusion_emitters": False}
 
 
 def child(mode: str) -> dict:
@@ -49,7 +52,7 @@ def child(mode: str) -> dict:
         t0 = time.perf_counter()
         low = F._value_and_jacobian.lower(prob, zf)
         t1 = time.perf_counter()
-    exe = low.compile(compiler_options=F._COMPILER_OPTIONS["cpu"]) if mode == "nan-options" else low.compile()
+    exe = low.compile(compiler_options=FUSION_EMITTERS_OFF) if mode == "nan-options" else low.compile()
     t2 = time.perf_counter()
     exe(prob, zf)[1].block_until_ready()
     runs = []

@@ -82,19 +82,15 @@ def _key(name: str, description: str, args: tuple) -> str:
     return name + "-" + hashlib.sha256((text + _source_hash()).encode()).hexdigest()[:32]
 
 
-def compiled(
-    name: str, fn: Callable, args: tuple, description: str, compiler_options: dict[str, Any] | None = None
-) -> Callable:
+def compiled(name: str, fn: Callable, args: tuple, description: str) -> Callable:
     """``jax.jit(fn)`` compiled for ``args`` (a tuple of arrays or lists of arrays), from this
     process's memory, from the directory of stored executables, or compiled now (and stored).
 
     ``description`` must determine ``fn`` completely apart from the arguments (e.g. the repr of the
     static part of the problem it closes over): two functions with equal ``name`` and
-    ``description`` are taken to be the same program. ``compiler_options``: XLA options for this
-    compilation (``Lowered.compile(compiler_options=...)``); if XLA rejects them, compiled without.
+    ``description`` are taken to be the same program.
     """
-    options = dict(sorted((compiler_options or {}).items()))
-    key = _key(name, description + repr(options), args)
+    key = _key(name, description, args)
     exe = _MEMORY.get(key)
     if exe is not None:
         return exe
@@ -114,11 +110,7 @@ def compiled(
             )
             exe = None
     if exe is None:
-        lowered = jax.jit(fn).lower(*args)
-        try:
-            exe = lowered.compile(compiler_options=options) if options else lowered.compile()
-        except Exception:  # an option this XLA does not know
-            exe = lowered.compile()
+        exe = jax.jit(fn).lower(*args).compile()
         if path is not None:
             _store(path, exe)
     _MEMORY[key] = exe

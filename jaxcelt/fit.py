@@ -623,9 +623,6 @@ def _value_and_jacobian(prob: _Problem, zf):
 _CALLS = [0]  # evaluations of (r, J) (reported as FitResult.n_eval)
 _ACTIVE: list = [None]  # the problem the callbacks evaluate (set by `fit`; not thread-safe)
 _COMPILE_LOCK = threading.Lock()
-# XLA's CPU fusion emitters off for the evaluation program: about half the compilation time at the
-# same run time (`benchmarks/fit_compile_parts.py` -> docs/fit/compile_parts.json)
-_COMPILER_OPTIONS = {"cpu": {"xla_cpu_use_fusion_emitters": False}}
 
 
 def _cpu_workers() -> int:
@@ -701,9 +698,7 @@ def _evaluate_program(prob: _Problem, zf: np.ndarray) -> tuple[np.ndarray, np.nd
 
     description = repr(jax.tree.structure(prob)) + repr(jax.tree.leaves(static))
     with _COMPILE_LOCK, runtime_checks_as_nan():  # one thread traces (the context swaps a global)
-        exe = compiled(
-            "fit-residuals-jacobian", f, (leaves, x), description, _COMPILER_OPTIONS.get(jax.default_backend())
-        )
+        exe = compiled("fit-residuals-jacobian", f, (leaves, x), description)
     r, J = (np.asarray(a) for a in exe(leaves, x))
     return (r.reshape(*lead, -1), J.reshape(*lead, -1, n)) if lead else (r, J)
 
