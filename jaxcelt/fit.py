@@ -17,8 +17,11 @@ Residuals r(z) (all dimensionless, stacked into one vector):
 loss = 1/2 |r|^2. Optimisers: ``"lm"`` (optimistix Levenberg-Marquardt, forward-mode Jacobians via
 ``diffrax.ForwardMode``), ``"gn"`` (optimistix Gauss-Newton), ``"gn-damped"`` (Gauss-Newton with a
 backtracking Armijo line search), ``"adam"`` and ``"lbfgs"`` (optax; gradient J^T r from the same
-forward-mode Jacobian). One program per problem shape holds the ODE solves (every record, padded
-to a common length, in one `jax.lax.map`); the optimisers call it through `jax.pure_callback`. Uncertainty (`FitResult.stderr`, ``ci95``, ``corr``): the Gauss-Newton
+forward-mode Jacobian). One program per problem shape holds the ODE solves (records padded to a
+common length; on a multi-core CPU the one-record program runs every record in its own thread,
+elsewhere one program runs them in a `jax.lax.map`); the optimisers call it through
+`jax.pure_callback`. With JAX's persistent cache directory set, that program is stored compiled and
+later processes load it (`jaxcelt._executable_cache`). Uncertainty (`FitResult.stderr`, ``ci95``, ``corr``): the Gauss-Newton
 approximation cov(z) = s^2 (J^T J)^-1 at the optimum with s^2 = RSS_misfit / (n_data - n_unknowns),
 marginalised over the window states, mapped to the physical parameters by the delta method.
 
