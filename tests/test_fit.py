@@ -158,7 +158,7 @@ def test_cli_fit(tmp_path, short_imu, capsys):
     assert set(ms["fits"][1]["start"]) == set(FREE)
     assert "starts reached the best loss" in capsys.readouterr().out
     with pytest.raises(SystemExit) as e:
-        main(["fit", str(path), "--starts", "2", "--optimiser", "adam"])
+        main(["fit", str(path), "--starts", "2", "--spans", "0.2,0.5"])
     assert e.value.code == 2 and "--starts" in capsys.readouterr().err
 
 

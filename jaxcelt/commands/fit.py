@@ -89,7 +89,7 @@ def run(args) -> int:
 
     import jaxcelt as jc
     from jaxcelt.data import MeasuredData, load_csv, load_data
-    from jaxcelt.fit import LSQ_OPTIMISERS, fit, fit_staged, multistart, random_guesses
+    from jaxcelt.fit import fit, fit_staged, multistart, random_guesses
 
     # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2)
     params0 = jc.CeltParams.paper(**overrides(args.set))
@@ -115,10 +115,10 @@ def run(args) -> int:
     params0 = jc.CeltParams.paper(**overrides(list(args.set) + guess))
     if args.starts > 1 and args.spans is not None:
         raise UsageError("argument --starts: cannot be combined with --spans")
-    if args.starts > 1 and args.optimiser not in LSQ_OPTIMISERS:
-        raise UsageError(f"argument --starts: needs a least-squares optimiser {LSQ_OPTIMISERS}, not {args.optimiser!r}")
     summary = None
-    bar = tqdm(total=args.max_iter, disable=args.quiet, desc=f"fit ({args.optimiser})", unit="it")
+    desc = f"fit ({args.optimiser})" if args.starts == 1 else f"fit ({args.optimiser}, {args.starts} starts)"
+    # several starts: iterations of all of them, no fixed total
+    bar = tqdm(total=args.max_iter if args.starts == 1 else None, disable=args.quiet, desc=desc, unit="it")
 
     def progress(it, loss, values):
         bar.update(1)
