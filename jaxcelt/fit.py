@@ -607,6 +607,17 @@ def _build(
     return prob, z0
 
 
+@eqx.filter_jit
+def _theta_and_jacobian(transforms: tuple, theta0: Array, zp: Array) -> tuple[Array, Array]:
+    """Physical values of the free parameters and d theta / d z at zp, in one small compiled program
+    (eager, the transforms' operations and their derivatives cost a compilation each)."""
+
+    def f(z):
+        return jnp.stack([tr.forward(z[i], theta0[i]) for i, tr in enumerate(transforms)])
+
+    return f(zp), jax.jacfwd(f)(zp)
+
+
 # ----------------------------------------------------------------------------- optimisers (jitted once per shape)
 @eqx.filter_jit
 def _residuals(prob: _Problem, z):
@@ -914,7 +925,7 @@ def fit(
     t_start = time.perf_counter()
 
     def values_of(zf) -> dict[str, float]:
-        th = np.asarray(prob.theta(zf[:P]))
+        th = np.asarray(_theta_and_jacobian(prob.transforms, prob.theta0, zf[:P])[0])
         return {n: float(th[i]) for i, n in enumerate(free)}
 
     loss_hist, par_hist = [], []
@@ -1018,7 +1029,7 @@ def _result(prob, zf, r, Jflat, a, loss_hist, par_hist, converged, compile_time,
     """`FitResult` at the final unknowns ``zf`` with residuals ``r`` and Jacobian ``Jflat`` there."""
     free, P = prob.free, len(prob.free)
     zf = jnp.asarray(zf)
-    th = np.asarray(prob.theta(zf[:P]))
+    th, dth = (np.asarray(a) for a in _theta_and_jacobian(prob.transforms, prob.theta0, zf[:P]))
     values = {n: float(th[i]) for i, n in enumerate(free)}
     z = prob.unflatten(zf)
     n_data = int(sum(float(jnp.sum(prob.rec.mask[k])) * OBSERVABLES[k] for k in prob.kinds))
@@ -1054,7 +1065,6 @@ def _result(prob, zf, r, Jflat, a, loss_hist, par_hist, converged, compile_time,
             nuisance["rotation_vector_stderr"] = se_n[:nr].tolist()
         if prob.fit_time_offset:
             nuisance["time_offset_stderr"] = (se_n[nr:] * TIME_OFFSET_SCALE).tolist()
-        dth = np.asarray(jax.jacfwd(prob.theta)(z["params"]))
         cov = dth @ cov_z @ dth.T
         se = np.sqrt(np.maximum(np.diag(cov), 0.0))
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -1266,7 +1276,8 @@ def _fit_batch(
             starts[i, j] = zj
     _ACTIVE[0] = prob
     t_start = time.perf_counter()
-    theta = jax.jit(jax.vmap(prob.theta))
+    def theta(zp):
+        return np.stack([np.asarray(_theta_and_jacobian(prob.transforms, prob.theta0, z)[0]) for z in zp])
     S = len(guesses)
     zs = jnp.asarray(starts)
     solver = _lsq_solver(a["optimiser"], a["rtol"], a["atol"])
