@@ -2,6 +2,7 @@
 transparent, continuation carries states. Compared against `jaxcelt.simulate` (the core
 entry point, not written for the sweep) and against numpy recomputation of the section times."""
 
+import dataclasses
 import json
 import os
 import subprocess
@@ -449,7 +450,11 @@ def test_two_processes_equal_one(paper_params, tmp_path):
     one = bifurcation(paper_params, values, **KW)
     got = {"samples": ds["section"].values, "num_steps": ds["num_steps"].values, "status": ds["status"].values}
     assert_same_lanes(got, {"samples": one.samples, "num_steps": one.num_steps, "status": one.status})
-    np.testing.assert_array_equal(ds["regime"].values, open_sweep_regimes(one, paper_params))
+    # the regimes stored by the 2-process run are those of its own lanes (labels are not compared
+    # with the one-process run's: samples of two compiled programs differ by rounding, and a label
+    # decided at a threshold could flip)
+    own = dataclasses.replace(one, samples=ds["section"].values)
+    np.testing.assert_array_equal(ds["regime"].values, open_sweep_regimes(own, paper_params))
 
 
 def open_sweep_regimes(result, params):
@@ -469,8 +474,8 @@ def test_float32_pool_agrees_with_float64(paper_params):
     r64 = bifurcation(paper_params, [15.0, 17.0], **kw)
     r32 = bifurcation(paper_params, [15.0, 17.0], dtype="float32", **kw)
     assert r32.samples.dtype == np.float64
-    np.testing.assert_array_equal(r32.status, r64.status)
-    assert np.all(r32.status == 0)
+    # both stay valid (no sticking, far from lift-off or tipping: a status, not a comparison of programs)
+    assert np.all(r64.status == 0) and np.all(r32.status == 0)
     np.testing.assert_allclose(r32.samples, r64.samples, rtol=0, atol=2e-3)
     with pytest.raises(ValueError, match="dtype"):
         bifurcation(paper_params, [15.0], dtype="float16", **kw)
