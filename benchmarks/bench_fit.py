@@ -32,25 +32,19 @@ import tempfile
 import time
 from pathlib import Path
 
-FREE = ("mu", "k_r", "b_Ts", "m_Ts")
+sys.path.insert(0, str(Path(__file__).parent))
+from _fit_problem import FREE, paper_and_true, records, release  # noqa: E402
 
 
 def other_problem(problem: str, optimiser: str, max_iter: int) -> list[dict]:
     """Runs in the child process: one fit of ``problem`` ("release", "chaos" or "adam-long")."""
     import dataclasses
 
-    import numpy as np
-
     import jaxcelt as jc
     from jaxcelt.data import generate_data, load_data
     from jaxcelt.fit import fit_staged
 
-    paper = jc.CeltParams.paper()
-    true = paper.replace(mu=0.2241 * 1.4, k_r=0.4345 * 0.6, b_Ts=0.5305 * 1.5, m_Ts=0.8161 * 1.35)
-
-    def release(p, tilt, spin, heading):
-        t = np.radians(tilt)
-        return jc.initial_state(p, omega=(0.0, 0.0, spin), n=(np.sin(t), 0.0, np.cos(t)), psi=heading)
+    paper, true = paper_and_true()
 
     t0 = time.perf_counter()
     if problem == "release":
@@ -75,11 +69,7 @@ def other_problem(problem: str, optimiser: str, max_iter: int) -> list[dict]:
         )  # fmt: skip
         compile_s, run_s, n_iter = res.compile_time, res.wall_time, res.n_iter
     else:  # adam-long
-
-        def start(spin, tilt):
-            return release(true, tilt, spin, 0.0)
-
-        data = generate_data(true, [start(5.0, 10.0), start(-3.0, 6.0)], 1.0, rate=100, kinds=("omega",))
+        data = records()
         t0 = time.perf_counter()
         res = jc.fit(data, paper, free=FREE, optimiser=optimiser, max_iter=max_iter)
         compile_s, run_s, n_iter = res.compile_time, res.wall_time, res.n_iter
@@ -106,21 +96,13 @@ def one(optimiser: str, max_iter: int, cache: str | None) -> list[dict]:
     if cache:
         jax.config.update("jax_compilation_cache_dir", cache)
         jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
-    import numpy as np
-
     import jaxcelt as jc
-    from jaxcelt.data import generate_data
 
-    paper = jc.CeltParams.paper()
-    true = paper.replace(mu=0.2241 * 1.4, k_r=0.4345 * 0.6, b_Ts=0.5305 * 1.5, m_Ts=0.8161 * 1.35)
-
-    def start(spin, tilt):
-        t = np.radians(tilt)
-        return jc.initial_state(true, omega=(0.0, 0.0, spin), n=(np.sin(t), 0.0, np.cos(t)))
+    paper, true = paper_and_true()
 
     rows = []
     for noise in (0.0, 0.01):
-        data = generate_data(true, [start(5.0, 10.0), start(-3.0, 6.0)], 1.0, rate=100, kinds=("omega",), noise=noise)
+        data = records(noise)
         t0 = time.perf_counter()
         res = jc.fit(data, paper, free=FREE, optimiser=optimiser, max_iter=max_iter)
         total = time.perf_counter() - t0

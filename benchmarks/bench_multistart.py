@@ -23,24 +23,17 @@ import sys
 import time
 from pathlib import Path
 
-FREE = ("mu", "k_r", "b_Ts", "m_Ts")
+sys.path.insert(0, str(Path(__file__).parent))
+from _fit_problem import FREE, paper_and_true, records  # noqa: E402
 
 
 def child(mode: str, n_starts: int) -> dict:
     import numpy as np
 
-    import jaxcelt as jc
-    from jaxcelt.data import generate_data
     from jaxcelt.fit import multistart
 
-    paper = jc.CeltParams.paper()
-    true = paper.replace(mu=0.2241 * 1.4, k_r=0.4345 * 0.6, b_Ts=0.5305 * 1.5, m_Ts=0.8161 * 1.35)
-
-    def start(spin, tilt):
-        t = np.radians(tilt)
-        return jc.initial_state(true, omega=(0.0, 0.0, spin), n=(np.sin(t), 0.0, np.cos(t)))
-
-    data = generate_data(true, [start(5.0, 10.0), start(-3.0, 6.0)], 1.0, rate=100, kinds=("omega",), noise=0.01)
+    paper, true = paper_and_true()
+    data = records(0.01)
     rng = np.random.default_rng(0)
     guesses = [{}] + [
         {n: float(getattr(paper, n)) * float(np.exp(rng.uniform(-np.log(2), np.log(2)))) for n in FREE}

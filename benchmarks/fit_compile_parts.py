@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import importlib
 import json
 import os
 import subprocess
@@ -25,25 +26,19 @@ import tempfile
 import time
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).parent))
+from _fit_problem import paper_and_true, records  # noqa: E402
+
 FUSION_EMITTERS_OFF = {"xla_cpu_use_fusion_emitters": False}
 
 
 def child(mode: str) -> dict:
-    import numpy as np
 
-    import jaxcelt as jc
     from jaxcelt._diffrax_adapter import runtime_checks_as_nan
-    from jaxcelt.data import generate_data
 
-    F = sys.modules["jaxcelt.fit"]
-    paper = jc.CeltParams.paper()
-    true = paper.replace(mu=0.2241 * 1.4, k_r=0.4345 * 0.6, b_Ts=0.5305 * 1.5, m_Ts=0.8161 * 1.35)
-
-    def start(spin, tilt):
-        t = np.radians(tilt)
-        return jc.initial_state(true, omega=(0.0, 0.0, spin), n=(np.sin(t), 0.0, np.cos(t)))
-
-    data = generate_data(true, [start(5.0, 10.0), start(-3.0, 6.0)], 1.0, rate=100, kinds=("omega",))
+    F = importlib.import_module("jaxcelt.fit")  # the module (jaxcelt.fit is also the function)
+    paper, _ = paper_and_true()
+    data = records()
     prob, z = F._build(data, paper, ("mu", "k_r", "b_Ts", "m_Ts"), {}, {}, 1, "optimise", False, 1e4, "fwd",
                        1e-8, 1e-10, 2000)  # fmt: skip
     zf = prob.flatten(z)

@@ -13,11 +13,15 @@ first; best of ``--reps`` warm calls each; the results of the modes are compared
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import os
 import sys
 import time
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).parent))
+from _fit_problem import paper_and_true, records  # noqa: E402
 
 
 def main(argv=None) -> int:
@@ -27,19 +31,11 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     import numpy as np
 
-    import jaxcelt as jc
-    from jaxcelt.data import generate_data
     from jaxcelt.versions import versions
 
-    F = sys.modules["jaxcelt.fit"]
-    paper = jc.CeltParams.paper()
-    true = paper.replace(mu=0.2241 * 1.4, k_r=0.4345 * 0.6, b_Ts=0.5305 * 1.5, m_Ts=0.8161 * 1.35)
-
-    def start(spin, tilt):
-        t = np.radians(tilt)
-        return jc.initial_state(true, omega=(0.0, 0.0, spin), n=(np.sin(t), 0.0, np.cos(t)))
-
-    data = generate_data(true, [start(5.0, 10.0), start(-3.0, 6.0)], 1.0, rate=100, kinds=("omega",))
+    F = importlib.import_module("jaxcelt.fit")  # the module (jaxcelt.fit is also the function)
+    paper, _ = paper_and_true()
+    data = records()
     prob, z = F._build(data, paper, ("mu", "k_r", "b_Ts", "m_Ts"), {}, {}, 1, "optimise", False, 1e4, "fwd",
                        1e-8, 1e-10, 2000)  # fmt: skip
     zf = np.asarray(prob.flatten(z))

@@ -608,14 +608,16 @@ def _build(
 
 
 @eqx.filter_jit
-def _theta_and_jacobian(transforms: tuple, theta0: Array, zp: Array) -> tuple[Array, Array]:
+def _theta_and_jacobian(prob: _Problem, zp: Array) -> tuple[Array, Array]:
     """Physical values of the free parameters and d theta / d z at zp, in one small compiled program
     (eager, the transforms' operations and their derivatives cost a compilation each)."""
+    return prob.theta(zp), jax.jacfwd(prob.theta)(zp)
 
-    def f(z):
-        return jnp.stack([tr.forward(z[i], theta0[i]) for i, tr in enumerate(transforms)])
 
-    return f(zp), jax.jacfwd(f)(zp)
+@eqx.filter_jit
+def _thetas(prob: _Problem, zps: Array) -> Array:
+    """Physical values of the free parameters of a batch of starts (S, P)."""
+    return jax.vmap(prob.theta)(zps)
 
 
 # ----------------------------------------------------------------------------- optimisers (jitted once per shape)
@@ -634,9 +636,9 @@ def _value_and_jacobian(prob: _Problem, zf):
 # optimiser, the uncertainty, multi-start and profile likelihood. The optimisers' own (small)
 # programs reach it through `jax.pure_callback`, so they never contain the solver and are compiled
 # in about a second, once per (residual length, unknowns, optimiser) for the whole process.
-_CALLS = [0]  # evaluations of (r, J) (reported as FitResult.n_eval)
 _ACTIVE: list = [None]  # the problem the callbacks evaluate (set by `fit`; not thread-safe)
 _COMPILE_LOCK = threading.Lock()
+_SPLIT: list = [None, None]  # the last problem `_evaluate` split into records, and its parts
 
 
 def _cpu_workers() -> int:
@@ -685,7 +687,9 @@ def _evaluate(prob: _Problem, zf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     R, workers = prob.n_records, min(prob.n_records, _cpu_workers())
     if R == 1 or workers == 1 or jax.default_backend() != "cpu":
         return _evaluate_program(prob, zf)
-    parts = [_one_record(prob, i) for i in range(R)]
+    if _SPLIT[0] is not prob:  # the split is per problem (one fit evaluates it many times)
+        _SPLIT[:] = [prob, [_one_record(prob, i) for i in range(R)]]
+    parts = _SPLIT[1]
     outs = list(_record_pool(workers).map(lambda part: _evaluate_program(part[0], zf[..., part[1]]), parts))
     r = np.empty((*zf.shape[:-1], prob.n_residuals))
     J = np.zeros((*zf.shape[:-1], prob.n_residuals, zf.shape[-1]))
@@ -718,7 +722,6 @@ def _evaluate_program(prob: _Problem, zf: np.ndarray) -> tuple[np.ndarray, np.nd
 
 
 def _host_vj(zf):
-    _CALLS[0] += 1
     # under vmap (multi-start) zf has leading batch axes: every start in one vmapped solve
     return _evaluate(_ACTIVE[0], np.asarray(zf, np.float64))
 
@@ -727,16 +730,6 @@ def _vj(zf: Array, m: int) -> tuple[Array, Array]:
     shapes = (jax.ShapeDtypeStruct((m,), zf.dtype), jax.ShapeDtypeStruct((m, zf.shape[-1]), zf.dtype))
     # under vmap the callback receives the whole batch (leading axes) and evaluates it at once
     return jax.pure_callback(_host_vj, shapes, zf, vmap_method="expand_dims")
-
-
-@eqx.filter_jit
-def _vj_jit(zf, m):
-    return _vj(zf, m)
-
-
-@eqx.filter_jit
-def _vj_batch_jit(zfs, m):
-    return jax.vmap(lambda z: _vj(z, m))(zfs)
 
 
 def _residual_fn(m: int):
@@ -925,7 +918,7 @@ def fit(
     t_start = time.perf_counter()
 
     def values_of(zf) -> dict[str, float]:
-        th = np.asarray(_theta_and_jacobian(prob.transforms, prob.theta0, zf[:P])[0])
+        th = np.asarray(_theta_and_jacobian(prob, zf[:P])[0])
         return {n: float(th[i]) for i, n in enumerate(free)}
 
     loss_hist, par_hist = [], []
@@ -977,9 +970,7 @@ def fit(
             if max_time is not None and iter_marks[-1] - t_start > max_time:
                 break
     compile_time, wall = _split_times(iter_marks)
-    # through the callback like the optimisers: called from this thread, the jit cache of
-    # `_value_and_jacobian` misses (measured: the solve was traced and compiled again)
-    r, J = (np.asarray(x) for x in _vj_jit(zf, m))
+    r, J = _evaluate(prob, np.asarray(zf))
     return _result(prob, zf, r, J, a, loss_hist, par_hist, converged, compile_time, wall, t_start)
 
 
@@ -1029,7 +1020,7 @@ def _result(prob, zf, r, Jflat, a, loss_hist, par_hist, converged, compile_time,
     """`FitResult` at the final unknowns ``zf`` with residuals ``r`` and Jacobian ``Jflat`` there."""
     free, P = prob.free, len(prob.free)
     zf = jnp.asarray(zf)
-    th, dth = (np.asarray(a) for a in _theta_and_jacobian(prob.transforms, prob.theta0, zf[:P]))
+    th, dth = (np.asarray(a) for a in _theta_and_jacobian(prob, zf[:P]))
     values = {n: float(th[i]) for i, n in enumerate(free)}
     z = prob.unflatten(zf)
     n_data = int(sum(float(jnp.sum(prob.rec.mask[k])) * OBSERVABLES[k] for k in prob.kinds))
@@ -1276,8 +1267,6 @@ def _fit_batch(
             starts[i, j] = zj
     _ACTIVE[0] = prob
     t_start = time.perf_counter()
-    def theta(zp):
-        return np.stack([np.asarray(_theta_and_jacobian(prob.transforms, prob.theta0, z)[0]) for z in zp])
     S = len(guesses)
     zs = jnp.asarray(starts)
     solver = _lsq_solver(a["optimiser"], a["rtol"], a["atol"])
@@ -1291,7 +1280,7 @@ def _fit_batch(
         jax.block_until_ready(zs)
         iter_marks.append(time.perf_counter())
         loss, done, ok = np.asarray(loss), np.asarray(done), np.asarray(ok)
-        th = np.asarray(theta(zs[:, :P]))
+        th = np.asarray(_thetas(prob, zs[:, :P]))
         for i in np.flatnonzero(~frozen):
             loss_hist[i].append(float(loss[i]))
             par_hist[i].append({n: float(th[i, j]) for j, n in enumerate(free)})
@@ -1306,7 +1295,7 @@ def _fit_batch(
         if a["max_time"] is not None and iter_marks[-1] - t_start > a["max_time"]:
             break
     compile_time, wall = _split_times(iter_marks)
-    r, J = (np.asarray(x) for x in _vj_batch_jit(zs, m))
+    r, J = _evaluate(prob, np.asarray(zs))
     zs = np.asarray(zs)
     return [
         _result(prob, zs[i], r[i], J[i], a, loss_hist[i], par_hist[i], converged[i], compile_time, wall, t_start)
