@@ -40,6 +40,13 @@ INVALID_KINDS = {
 }
 STATUS = {0: "success", 1: "max_steps reached", 2: "stopped at invalid state", 3: "solver failure"}
 
+MIN_STEP_ULPS = 10
+"""A rejected step that would shrink the step below this many ULPs of t (or make it NaN) ends the
+solve as a solver failure (``status == 3``): scipy's ``solve_ivp`` rule ("required step size is
+less than spacing between numbers"). Without it an adaptive solve caught at a singularity (e.g. the
+heading's 1/(1 - n2^2) when a stone integrated on past validity lies on its side) rejects
+steps of a few ULPs until ``max_steps`` is spent (docs/bifurcation/max-steps.md)."""
+
 
 class Validity(NamedTuple):
     """Monitor carried through the solve (updated only on accepted steps)."""
@@ -144,7 +151,8 @@ class Solution(eqx.Module):
 
     ``ys[i]`` is the state at ``ts[i]``; entries after an early stop are ``inf`` (diffrax's
     convention). ``status``: 0 success, 1 max_steps reached, 2 stopped at an invalid state
-    (``stop_on_invalid=True``), 3 other solver failure (see `STATUS`). ``success`` is
+    (``stop_on_invalid=True``), 3 other solver failure, e.g. the step size collapsed below
+    `MIN_STEP_ULPS` ULPs of t (see `STATUS`). ``success`` is
     ``status == 0``; ``valid`` is False as soon as the model left its validity (even if the
     solve went on).
     """
@@ -177,6 +185,55 @@ class Solution(eqx.Module):
 
 
 DEFAULT_SOLVER = diffrax.Tsit5()
+
+
+def step_too_small(keep: Array, t0: Array, t1: Array) -> Array:
+    """Whether a step proposal ends the solve (`MIN_STEP_ULPS`): the last step was rejected and the
+    next one, from ``t0`` to ``t1``, spans fewer than `MIN_STEP_ULPS` ULPs of ``t0``, nothing at
+    all (at t0 = 0 the ULP is a denormal, which XLA's CPU code flushes to zero), or is not a
+    number (a NaN error estimate gives diffrax's PID controller a NaN step, which no shrinking
+    would end)."""
+    t0, t1 = jax.lax.stop_gradient((t0, t1))  # a decision, not a value: times may carry tangents
+    ulp = jnp.abs(jnp.nextafter(t0, jnp.asarray(jnp.inf, t0.dtype)) - t0)
+    dt = t1 - t0
+    return ~keep & ~((dt >= MIN_STEP_ULPS * ulp) & (dt > 0))
+
+
+class MinStepController(diffrax.AbstractAdaptiveStepSizeController):
+    """An adaptive step-size controller that gives up where the step size collapses.
+
+    Wraps any adaptive controller (``PIDController``, ``ClipStepSizeController``) and returns
+    ``diffrax.RESULTS.dt_min_reached`` (status 3) where `step_too_small`; otherwise the wrapped
+    controller's decisions unchanged."""
+
+    controller: diffrax.AbstractAdaptiveStepSizeController
+
+    @property
+    def rtol(self):
+        return self.controller.rtol
+
+    @property
+    def atol(self):
+        return self.controller.atol
+
+    @property
+    def norm(self):  # pyright: ignore[reportIncompatibleMethodOverride]
+        return self.controller.norm
+
+    def wrap(self, direction):
+        return MinStepController(self.controller.wrap(direction))
+
+    def init(self, terms, t0, t1, y0, dt0, args, func, error_order):
+        return self.controller.init(terms, t0, t1, y0, dt0, args, func, error_order)
+
+    def adapt_step_size(self, t0, t1, y0, y1_candidate, args, y_error, error_order, controller_state):
+        keep, next_t0, next_t1, jump, state, result = self.controller.adapt_step_size(
+            t0, t1, y0, y1_candidate, args, y_error, error_order, controller_state
+        )
+        R = diffrax.RESULTS
+        small = step_too_small(keep, next_t0, next_t1)
+        result = R.where(small & (result == R.successful), R.dt_min_reached, result)
+        return keep, next_t0, next_t1, jump, state, result
 
 
 def status_code(result) -> Array:
@@ -241,6 +298,7 @@ def _solve(
         controller = diffrax.PIDController(rtol=rtol, atol=atol)
         if exact_ts and ts is not None:
             controller = diffrax.ClipStepSizeController(controller, step_ts=ts)
+        controller = MinStepController(controller)
     mon_solver = MonitoredSolver(solver=solver, law=law)
     if ts is not None:
         saveat = diffrax.SaveAt(ts=ts, solver_state=True)
@@ -322,6 +380,8 @@ def simulate(
             solver without error estimate; ``dt0`` with an adaptive solver is only the first step.
         dt0: initial (or, for non-adaptive solvers, fixed) step [s].
         max_steps: step budget; hitting it gives ``status == 1`` rather than an exception.
+            A step size that collapses to a few ULPs of t ends the solve earlier, with
+            ``status == 3`` (`MIN_STEP_ULPS`).
         contact_law: a law object or name (`jaxcelt.contact.CONTACT_LAWS`); default the
             paper's generalised Pade law (eq. 13).
         stop_on_invalid: end the solve at the first accepted step whose end state is invalid

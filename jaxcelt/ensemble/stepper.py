@@ -1,7 +1,8 @@
 """Lane steppers: one step of one lane, exactly as `jaxcelt.simulate` would take it.
 
 A stepper advances a `LaneState` by one step of diffrax's integration loop: the solver step,
-``PIDController`` inside ``ClipStepSizeController(step_ts=section times)``, diffeqsolve's
+``PIDController`` inside ``ClipStepSizeController(step_ts=section times)`` inside
+`jaxcelt.solve.MinStepController` (as `simulate` builds it), diffeqsolve's
 first-step choice and end-of-interval clipping, the validity monitor and the stop-on-invalid
 event. Because the controller steps onto every section time, the end of an accepted step that
 lands on the next section time *is* that sample: ``step`` says when (``hit``).
@@ -39,7 +40,7 @@ from .._types import Array
 from ..contact import AbstractContactLaw, get_contact_law
 from ..model import vector_field_and_normal
 from ..params import CeltParams
-from ..solve import MonitoredSolver, _Field, _fill_implicit_tols, invalid_kind
+from ..solve import MinStepController, MonitoredSolver, _Field, _fill_implicit_tols, invalid_kind, step_too_small
 from .lanes import LaneMonitor, LaneState
 
 __all__ = [
@@ -73,10 +74,10 @@ class FusedStepState(eqx.Module):
     """min n3 over accepted step ends (max tilt = arccos of it: arccos is decreasing)"""
 
 
-def _controller(tols: Array, ts: Array) -> diffrax.ClipStepSizeController:
+def _controller(tols: Array, ts: Array) -> MinStepController:
     # the controller `simulate(..., exact_ts=True)` builds, tolerances traced (module docstring)
     pid = diffrax.PIDController(rtol=tols[0], atol=tols[1])
-    return diffrax.ClipStepSizeController(pid, step_ts=ts)
+    return MinStepController(diffrax.ClipStepSizeController(pid, step_ts=ts))
 
 
 def _section_hit(ts: Array, k: Array, keep: Array, tprev: Array) -> tuple[Array, Array]:
@@ -212,7 +213,8 @@ class FusedERKStepper(AbstractLaneStepper):
     y0 + sum_j a_ij k_j), y1 = y0 + sum b_i k_i, error sum e_i k_i, the RMS error ratio and
     factor clip(0.9 err^(-1/q), [1, 10] if accepted else [0.2, 0.9]) with q the error order
     diffrax gives its controller (Tsit5 5, Dopri8 8), the next step clipped onto the next
-    section time and onto t1. The last stage is f(t1, y1) (FSAL); its normal force and
+    section time and onto t1, a collapsed step size ending the lane (`jaxcelt.solve.step_too_small`).
+    The last stage is f(t1, y1) (FSAL); its normal force and
     denominator feed the validity monitor, so monitoring costs no extra evaluation
     (`MonitoredSolver` evaluates N once more per step). Without diffrax's generic stage loop,
     stage buffer and dense-output bookkeeping, XLA fuses the step into fewer kernels.
@@ -276,12 +278,13 @@ class FusedERKStepper(AbstractLaneStepper):
         S = ts.shape[0]
         hit, k = _section_hit(ts, lane.k, keep, tprev)
         tnext = jnp.where(k < S, jnp.minimum(ts[jnp.minimum(k, S - 1)], tnext), tnext)  # diffrax's _clip_t
+        small = step_too_small(keep, tprev, tnext)  # `MinStepController`
         tprev, tnext = clip_to_end(tprev, tnext, t1, lane.floor, keep)
         # validity monitor at the accepted step's end (N, den from the FSAL evaluation)
         N, den = aux
         kind = invalid_kind(N, den, y1[8])
         new_invalid = keep & (kind > 0) & (st.first_invalid_kind == 0)
-        result = lane.result
+        result = R.where(small & (lane.result == R.successful), R.dt_min_reached, lane.result)
         if self.stop_on_invalid:
             result = R.where(new_invalid & (result == R.successful), R.event_occurred, result)
         num_steps = lane.num_steps + 1
