@@ -199,7 +199,9 @@ def _validate(p: CeltParams) -> None:
         raise ValueError(f"parameter 'v_pi_sign' must be +1 or -1, got {vals['v_pi_sign']}")
     if not np.all(np.isin(vals["derivative_exact"], (0.0, 1.0))):
         raise ValueError(f"parameter 'derivative_exact' must be False/True (0 or 1), got {vals['derivative_exact']}")
-    B = np.asarray(inertia_tensor(jax.tree_util.tree_map(np.asarray, p)))
+    # `inertia_tensor` in numpy (eager jnp would compile a program per operation)
+    B1, B2, B3, B12, B13, B23 = np.broadcast_arrays(*(vals[k] for k in ("B1", "B2", "B3", "B12", "B13", "B23")))
+    B = np.stack([np.stack([B1, -B12, -B13], -1), np.stack([-B12, B2, -B23], -1), np.stack([-B13, -B23, B3], -1)], -2)
     eig = np.linalg.eigvalsh(B)
     if np.any(eig <= 0):
         raise ValueError(f"inertia tensor 'B' (B1, B2, B3, B12, B13, B23) must be positive definite; eigenvalues {eig}")

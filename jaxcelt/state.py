@@ -79,11 +79,17 @@ def initial_state(
             )
     else:
         n = n / jnp.linalg.norm(n)
+    return _state_on_manifold(omega, n, psi, v_A, position, params)
+
+
+@jax.jit
+def _state_on_manifold(omega, n, psi, v_A, position, params: CeltParams) -> State:
+    # one compiled program (called eagerly, each operation would compile one of its own)
     v_A = v_A - jnp.dot(v_A, n) * n
     geom = contact_geometry(n, omega, params)
     v = v_A - jnp.cross(omega, geom.rho)
     frame = horizontal_frame(n, psi)
-    r_C = frame.to_global(-geom.rho, n) + jnp.concatenate([position, jnp.zeros(1)])
+    r_C = frame.to_global(-geom.rho, n) + jnp.concatenate([position, jnp.zeros(1, position.dtype)])
     return jnp.concatenate([v, omega, n, r_C, psi[None]])
 
 
@@ -94,6 +100,9 @@ def constraint_residual(y: State, params: CeltParams) -> tuple[ArrayLike, ArrayL
     v_A = v + jnp.cross(omega, geom.rho)
     # height of C above the base is -rho . n; r_C3 must equal it.
     return jnp.linalg.norm(n) - 1.0, jnp.dot(v_A, n), r_C[2] + jnp.dot(geom.rho, n)
+
+
+_constraint_residual_jit = jax.jit(constraint_residual)
 
 
 def check_state(y: ArrayLike, params: CeltParams, *, name: str = "y0", tol: float = MANIFOLD_TOL) -> None:
@@ -120,7 +129,7 @@ def check_state(y: ArrayLike, params: CeltParams, *, name: str = "y0", tol: floa
             if pb is not None
             else jax.tree_util.tree_map(lambda x, i=i: x.reshape(-1)[i] if np.size(x) == len(flat) else x, params)
         )
-        dn, c, h = (float(v) for v in constraint_residual(jnp.asarray(yi), p))
+        dn, c, h = (float(v) for v in _constraint_residual_jit(jnp.asarray(yi), p))
         where = f"{name}[{i}]" if len(flat) > 1 else name
         if abs(dn) > tol:
             raise ValueError(f"{where!r}: n (components 6:9) must be a unit vector, |n| - 1 = {dn:.3g}")

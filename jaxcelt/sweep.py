@@ -724,6 +724,9 @@ def continuation(
     return out
 
 
+_centre_positions = jax.jit(jax.vmap(centre_position, in_axes=(0, None)))
+
+
 def orbit(
     params: CeltParams,
     y0: Any = None,
@@ -756,7 +759,7 @@ def orbit(
         contact_law=contact_law, exact_ts=True,
     )  # fmt: skip
     ys = np.asarray(sol.ys)
-    r_O = np.asarray(jax.vmap(centre_position, in_axes=(0, None))(sol.ys, params))
+    r_O = np.asarray(_centre_positions(sol.ys, params))
     return dict(
         ts=ts,
         ys=ys,

@@ -247,7 +247,7 @@ def run_lanes_with_stats(
     if cfg.lyapunov_periods > 0 and not compile_only:
         ok = np.flatnonzero(out["status"] == 0)
         ok = ok[np.argsort(-out["num_steps"][ok], kind="stable")]  # similar cost side by side
-        G = W * ndev
+        G = Wd * ndev  # the pool's width: a chunk of few lanes solves no padding copies
         for i in range(0, len(ok), G):
             idx = pad_lanes(ok[i : i + G], G)
             lam = _lyap_chunk(
@@ -282,7 +282,7 @@ def run_lanes(
     ``pilot_fraction`` (default `PILOT_FRACTION`; 0 = off; only used when a device has more
     lanes than slots): each lane pauses once after this fraction of its time span and is taken
     up again costliest-predicted first. The Lyapunov stage (``cfg.lyapunov_periods > 0``) then
-    runs vmapped over the successful lanes in groups of ``width`` ordered by the measured
+    runs vmapped over the successful lanes in groups of the pool's width ordered by the measured
     main-solve step count (a cost estimate that needs no pilot run).
 
     Sharded over ``devices`` (default all local devices; lanes are dealt round-robin); padded
