@@ -228,7 +228,7 @@ def test_pool_other_solvers_equal_simulate(paper_params, solver):
 
 
 def test_pool_drain_compaction_keeps_lanes(paper_params):
-    # 40 lanes through 32 slots: once <= 16 lanes are left the pool continues 16 wide
+    # 40 lanes through 32 slots: once <= 8 lanes are left the pool continues 8 wide
     # (`_pool`'s drain). Lanes must not depend on the width they ran at: compare with a
     # pool that is 8 wide from the start. Different widths are different compiled programs
     # (on an AVX-512 CPU ~half the samples differ at <= 1.6e-12 relative), so: same step

@@ -1,0 +1,95 @@
+"""The pool's drain: what one pool iteration costs at a given width, and drain schedules A/B.
+
+1. The lanes of the 400 x 300 sweep (omega_pi in [10, 20] from rest, rtol 1e-8) that run to
+   ``max_steps`` when integrated on, run alone (no queue, so no drain) at 3 slots per device and
+   in pools of 6 and 16 slots per device (padding lanes): seconds per pool iteration.
+2. The whole sweep, stopping at invalid states and integrating on, with the drain halving down to
+   16 slots (96, 48, 24) and dividing by 4 down to 4 slots (96, 24, 6): compile apart, run time,
+   iterations, step slots paid.
+
+    .venv/bin/python benchmarks/bench_drain.py --out docs/bifurcation
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import time
+from pathlib import Path
+
+import jax
+import numpy as np
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--n-freq", type=int, default=400)
+    ap.add_argument("--tail-max-steps", type=int, default=300_000, help="step budget of the lone-lane runs")
+    ap.add_argument("--out", type=Path, default=None)
+    a = ap.parse_args()
+    jax.config.update("jax_num_cpu_devices", os.cpu_count() or 1)
+    import jaxcelt as jc
+    from jaxcelt.ensemble import pool
+    from jaxcelt.ensemble import stroboscopic as sb
+    from jaxcelt.sweep import SweepConfig
+    from jaxcelt.versions import versions
+
+    V = versions()
+    print(" ".join(f"{k}={v}" for k, v in V.items()), flush=True)
+    res: dict = dict(versions=V, cpu_count=os.cpu_count(), load_average_at_start=os.getloadavg())
+    p = jc.CeltParams.paper()
+    vals = np.linspace(10.0, 20.0, a.n_freq)
+    y0 = np.tile(np.asarray(jc.initial_state(p)), (len(vals), 1))
+
+    def run(v, cfg, reps=1, **kw):
+        pb = sb.lanes_params(p, "omega_pi", v)
+        t = time.perf_counter()
+        sb.run_lanes_with_stats(pb, y0[: len(v)], cfg, compile_only=True, varying=("omega_pi",), **kw)
+        tc = time.perf_counter() - t
+        runs = []
+        for _ in range(reps):
+            t = time.perf_counter()
+            out, st = sb.run_lanes_with_stats(pb, y0[: len(v)], cfg, varying=("omega_pi",), **kw)
+            runs.append(time.perf_counter() - t)
+        status = {int(k): int(c) for k, c in zip(*np.unique(out["status"], return_counts=True))}
+        return out, dict(
+            compile_s=tc, run_s=float(np.median(runs)), runs_s=runs, iterations=st.iterations,
+            slot_steps=st.slot_steps, steps=int(out["num_steps"].sum()), status_counts=status,
+        )  # fmt: skip
+
+    schedules = {"halve_to_16": (16, 2), "quarter_to_4": (4, 4)}
+    res["schedules"] = {}
+    long = None
+    for name, (md, fac) in schedules.items():
+        pool.run_pool.__kwdefaults__.update(min_drain_width=md, drain_factor=fac)
+        res["schedules"][name] = dict(min_drain_width=md, drain_factor=fac)
+        for stop in (True, False):
+            cfg = SweepConfig(transient_periods=200, sample_periods=100, stop_on_invalid=stop)
+            out, r = run(vals, cfg, reps=3 if stop else 1)
+            res["schedules"][name]["stop_on_invalid" if stop else "integrate_on"] = r
+            print(name, "stop" if stop else "on", r, flush=True)
+            if not stop and long is None:
+                long = np.flatnonzero(out["status"] == 1)
+    pool.run_pool.__kwdefaults__.update(min_drain_width=pool.MIN_DRAIN_WIDTH, drain_factor=pool.DRAIN_FACTOR)
+
+    # 1. per-iteration cost against the width, on the lanes that run longest
+    lv = vals[long]
+    cfg = SweepConfig(transient_periods=200, sample_periods=100, stop_on_invalid=False, max_steps=a.tail_max_steps)
+    ndev = len(jax.devices())
+    res["lone_lanes"] = dict(omega_pi=lv.tolist(), max_steps=a.tail_max_steps, widths={})
+    for pad in (None, 6 * ndev, 16 * ndev):
+        _, r = run(lv, cfg, pad_to=pad)
+        w = -(-max(len(lv), pad or 0) // ndev)
+        r["us_per_iteration"] = 1e6 * r["run_s"] / r["iterations"]
+        res["lone_lanes"]["widths"][str(w)] = r
+        print("lone lanes, width", w, r, flush=True)
+    res["load_average_at_end"] = os.getloadavg()
+    if a.out:
+        a.out.mkdir(parents=True, exist_ok=True)
+        (a.out / "drain.json").write_text(json.dumps(res, indent=1))
+        print("wrote", a.out / "drain.json")
+
+
+if __name__ == "__main__":
+    main()
