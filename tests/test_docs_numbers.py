@@ -138,7 +138,7 @@ QUOTES = [
     (
         "docs/bifurcation/README.md",
         lambda: (
-            f"{_bench()['jaxcelt_lane_by_lane']['seconds'] / _bench()['jaxcelt_pool']['seconds']:.1f}× (1 197 s extrapolated against the pool's {_bench()['jaxcelt_pool']['seconds']:.1f} s)"
+            f"{_bench()['jaxcelt_lane_by_lane']['seconds'] / _bench()['jaxcelt_pool']['seconds']:.1f}× ({_bench()['jaxcelt_lane_by_lane']['seconds']:,.0f} s extrapolated against the pool's {_bench()['jaxcelt_pool']['seconds']:.1f} s)".replace(",", " ")
         ),
     ),
     (
