@@ -56,10 +56,11 @@ MIN_DRAIN_WIDTH = 4
 """narrowest pool of the drain"""
 DRAIN_FACTOR = 4
 """each width of the drain is the previous one divided by this: 96, 24, 6 slots. An iteration
-costs about 10 us plus 1.1 us per slot on a 2-core CPU (the lanes that run longest alone: 13 us
-at 3 slots, 28 us at 16), so the last few long lanes should run in a narrow pool; with a factor
-of 4 that takes no more compiled widths than halving down to 24 did (400 lanes x 300 periods
-integrated on: 31.9 s instead of 41.4 s; docs/bifurcation/README.md)"""
+costs about 10 us plus 1.1 us per slot on a 2-core CPU (the lanes that run longest, alone:
+12.8 us at 3 slots, 26.9 us at 16), so the last few long lanes should run in a narrow pool; with
+a factor of 4 that takes no more compiled widths than halving down to 24 did (400 lanes x 300
+periods integrated on: 30.4 s instead of 40.3 s; ``benchmarks/bench_drain.py`` ->
+docs/bifurcation/drain.json)"""
 PILOT_FRACTION = 0.1
 """a lane pauses once after this fraction of its time span and waits for a slot with its
 predicted remaining cost (``benchmarks/bench_schedule.py``)"""
