@@ -204,7 +204,9 @@ class MinStepController(diffrax.AbstractAdaptiveStepSizeController):
 
     Wraps any adaptive controller (``PIDController``, ``ClipStepSizeController``) and returns
     ``diffrax.RESULTS.dt_min_reached`` (status 3) where `step_too_small`; otherwise the wrapped
-    controller's decisions unchanged."""
+    controller's decisions unchanged. (``PIDController(dtmin=..., force_dtmin=False)`` ends a solve
+    below an absolute step size, which cannot follow the spacing of floats at every t, and lets a
+    NaN step through.)"""
 
     controller: diffrax.AbstractAdaptiveStepSizeController
 
