@@ -103,7 +103,7 @@ def main():
             }
         )
     res["lanes"] = rows
-    res["note"] = "each entry: [accepted+rejected steps, status] (0 ok, 1 max_steps, 3 non-finite)"
+    res["note"] = "each entry: [accepted+rejected steps, status] (0 ok, 1 max_steps, 3 non-finite error or collapsed step)"
     print(f"{'omega_pi':>9} {'nb DP5':>14} {'nb Tsit5':>14} {'jc Tsit5':>14} {'jc Dopri5':>14}")
     for r in rows:
         print(f"{r['omega_pi']:9.4f} " + " ".join(f"{s:>11d}/{c}" for s, c in (r["numba_dp5"], r["numba_tsit5"], r["jaxcelt_tsit5"], r["jaxcelt_dopri5"])))  # fmt: skip
