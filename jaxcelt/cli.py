@@ -42,14 +42,17 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _enable_compile_cache() -> None:
     """Persistent XLA compilation cache for the command line (a rerun or a resumed sweep skips
-    the compile). Directory: $JAXCELT_CACHE_DIR, default ~/.cache/jaxcelt/xla; "off" disables."""
+    the compile). Directory: $JAXCELT_CACHE_DIR, default ~/.cache/jaxcelt/xla; "off" disables.
+    Programs that compile in under a second are not stored unless JAX's own
+    $JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS says otherwise."""
     import jax
 
     d = os.environ.get("JAXCELT_CACHE_DIR", os.path.join(os.path.expanduser("~"), ".cache", "jaxcelt", "xla"))
     if d.strip().lower() in ("", "0", "off", "none"):
         return
     jax.config.update("jax_compilation_cache_dir", d)
-    jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
+    if "JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS" not in os.environ:
+        jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
 
 
 def main(argv: list[str] | None = None) -> int:

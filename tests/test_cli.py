@@ -118,9 +118,11 @@ def test_import_does_not_start_the_jax_backend():
 
 
 def test_compile_cache_is_written(tmp_path):
-    # the CLI's persistent XLA cache: a run fills $JAXCELT_CACHE_DIR (a rerun then skips compiling)
+    # the CLI's persistent XLA cache: a run fills $JAXCELT_CACHE_DIR (a rerun then skips compiling).
+    # Every program is stored (threshold 0 s): with the CLI's default of 1 s, whether this small
+    # program is stored would depend on how fast the CPU compiles it.
     cache = tmp_path / "xla"
-    env = dict(os.environ, JAXCELT_CACHE_DIR=str(cache))
+    env = dict(os.environ, JAXCELT_CACHE_DIR=str(cache), JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS="0")
     cmd = [sys.executable, "-m", "jaxcelt", "simulate", "--omega-pi", "17", "--periods", "1", "--out", str(tmp_path)]
     subprocess.run(cmd, env=env, check=True, capture_output=True)
     assert cache.is_dir() and any(cache.iterdir())
