@@ -19,6 +19,7 @@ executable runs code from the file: the directory must be the user's own, as JAX
 
 from __future__ import annotations
 
+import concurrent.futures
 import functools
 import hashlib
 import os
@@ -32,7 +33,7 @@ from typing import Any
 
 import jax
 
-_MEMORY: dict[str, Any] = {}
+_MEMORY: dict[str, Any] = {}  # key -> executable, or a Future of one being compiled in the background
 SUBDIR = "jaxcelt-executables"
 
 
@@ -75,46 +76,92 @@ def cache_dir() -> Path | None:
     return Path(d) / SUBDIR if d else None
 
 
-def _key(name: str, description: str, args: tuple) -> str:
+def _key(name: str, description: str, args: tuple, options: dict | None = None) -> str:
     shapes = [(tuple(a.shape), str(a.dtype)) for a in jax.tree.leaves(args)]
     env = [os.environ.get(v, "") for v in ("EQX_ON_ERROR", "XLA_FLAGS")]
-    text = "\n".join([name, description, repr(jax.tree.structure(args)), repr(shapes), repr(env), _environment()])
+    opts = repr(sorted((options or {}).items()))
+    text = "\n".join([name, description, repr(jax.tree.structure(args)), repr(shapes), repr(env), opts, _environment()])
     return name + "-" + hashlib.sha256((text + _source_hash()).encode()).hexdigest()[:32]
 
 
-def compiled(name: str, fn: Callable, args: tuple, description: str) -> Callable:
+def compiled(name: str, fn: Callable, args: tuple, description: str, options: dict | None = None) -> Callable:
     """``jax.jit(fn)`` compiled for ``args`` (a tuple of arrays or lists of arrays), from this
     process's memory, from the directory of stored executables, or compiled now (and stored).
 
     ``description`` must determine ``fn`` completely apart from the arguments (e.g. the repr of the
     static part of the problem it closes over): two functions with equal ``name`` and
-    ``description`` are taken to be the same program.
+    ``description`` are taken to be the same program. If `compile_in_background` has started
+    this program, the call waits for it. ``options``: XLA compiler options of this program.
     """
-    key = _key(name, description, args)
+    key = _key(name, description, args, options)
     exe = _MEMORY.get(key)
-    if exe is not None:
-        return exe
-    from jax.experimental import serialize_executable
+    if exe is None:
+        exe = _load(key)
+        if exe is None:
+            exe = jax.jit(fn).lower(*args).compile(options)
+            _store_for(key, exe)
+        _MEMORY[key] = exe
+    if isinstance(exe, concurrent.futures.Future):
+        try:
+            exe = exe.result()
+        except BaseException:
+            _MEMORY.pop(key, None)  # a later call compiles again
+            raise
+        _MEMORY[key] = exe
+    return exe
 
+
+@functools.cache
+def _compiler() -> concurrent.futures.ThreadPoolExecutor:
+    return concurrent.futures.ThreadPoolExecutor(max_workers=1, thread_name_prefix="jaxcelt-compile")
+
+
+def compile_in_background(name: str, fn: Callable, args: tuple, description: str, options: dict | None = None) -> None:
+    """Start making the program `compiled` would return: traced and lowered now (in the calling
+    thread: tracing is Python), compiled by XLA on a worker thread, so that the caller can trace and
+    compile its other programs meanwhile (XLA's CPU compilation of one program uses one core and
+    releases the GIL). A program already in memory or on disk is loaded now instead."""
+    key = _key(name, description, args, options)
+    if key in _MEMORY:
+        return
+    exe = _load(key)
+    if exe is not None:
+        _MEMORY[key] = exe
+        return
+    lowered = jax.jit(fn).lower(*args)
+
+    def finish():
+        out = lowered.compile(options)
+        _store_for(key, out)
+        return out
+
+    _MEMORY[key] = _compiler().submit(finish)
+
+
+def _load(key: str) -> Any:
+    """The stored executable of ``key``, or None (none stored, no directory, or unreadable)."""
     d = cache_dir()
     path = d / f"{key}.bin" if d is not None else None
-    if path is not None and path.exists():
-        try:
-            payload, in_tree, out_tree = pickle.loads(path.read_bytes())
-            exe = serialize_executable.deserialize_and_load(payload, in_tree, out_tree)
-        except Exception as e:  # truncated, damaged or foreign file: compile again and replace it
-            warnings.warn(
-                f"jaxcelt: stored executable {path} could not be loaded ({type(e).__name__}: {e}); recompiling",
-                RuntimeWarning,
-                stacklevel=2,
-            )
-            exe = None
-    if exe is None:
-        exe = jax.jit(fn).lower(*args).compile()
-        if path is not None:
-            _store(path, exe)
-    _MEMORY[key] = exe
-    return exe
+    if path is None or not path.exists():
+        return None
+    from jax.experimental import serialize_executable
+
+    try:
+        payload, in_tree, out_tree = pickle.loads(path.read_bytes())
+        return serialize_executable.deserialize_and_load(payload, in_tree, out_tree)
+    except Exception as e:  # truncated, damaged or foreign file: compile again and replace it
+        warnings.warn(
+            f"jaxcelt: stored executable {path} could not be loaded ({type(e).__name__}: {e}); recompiling",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+        return None
+
+
+def _store_for(key: str, exe: Any) -> None:
+    d = cache_dir()
+    if d is not None:
+        _store(d / f"{key}.bin", exe)
 
 
 def _store(path: Path, exe: Any) -> None:

@@ -53,7 +53,7 @@ import optimistix as optx
 
 from . import _config  # noqa: F401
 from ._diffrax_adapter import runtime_checks_as_nan
-from ._executable_cache import compiled
+from ._executable_cache import compile_in_background, compiled
 from ._types import Array, State
 from .data import OBSERVABLES, SENSOR_KINDS, MeasuredData, observe, rotation_matrix
 from .model import contact_geometry
@@ -195,6 +195,16 @@ class _Record(eqx.Module):
     free_windows: tuple[int, ...] = eqx.field(static=True)
 
 
+def _map1(mapper: Callable, fn: Callable, xs: Any) -> Any:
+    """``mapper(fn)(xs)`` over the leading axis (``jax.vmap`` or ``jax.lax.map``); with a single
+    element, ``fn`` is called on it directly: a loop or batch of one adds a layer that every
+    transformation (the Jacobian's JVP and its vmap over the unknowns) re-traces, which costs
+    seconds of tracing for a program holding an ODE solve."""
+    if jax.tree.leaves(xs)[0].shape[0] == 1:
+        return jax.tree.map(lambda a: a[None], fn(jax.tree.map(lambda a: a[0], xs)))
+    return jax.vmap(fn)(xs) if mapper is jax.vmap else mapper(fn, xs)
+
+
 class _Problem(eqx.Module):
     """Residual function of a fit; a pytree so that jit caches across fits of the same shape."""
 
@@ -234,10 +244,11 @@ class _Problem(eqx.Module):
             return fixed.at[jnp.array(self.rec.free_windows)].set(zs * STATE_SCALE[None, :])
         return fixed
 
-    def sensor(self, z) -> tuple[Array, Array]:
-        """(rotation vector (3,) of the sensor axes [rad], time offsets (R,) [s]): given + fitted."""
-        rv = self.rec.rotation0 + (z["rotation"] if self.fit_rotation else 0.0)
-        off = self.rec.offset0 + (z["offsets"] * TIME_OFFSET_SCALE if self.fit_time_offset else 0.0)
+    def sensor(self, z, xp=jnp) -> tuple[Array, Array]:
+        """(rotation vector (3,) of the sensor axes [rad], time offsets (R,) [s]): given + fitted
+        (``xp=np``: on the host, for concrete ``z``)."""
+        rv = xp.asarray(self.rec.rotation0) + (z["rotation"] if self.fit_rotation else 0.0)
+        off = xp.asarray(self.rec.offset0) + (z["offsets"] * TIME_OFFSET_SCALE if self.fit_time_offset else 0.0)
         return rv, off
 
     def _simulate_record(self, p, zs, fixed, ts) -> tuple[Array, Array]:
@@ -258,14 +269,15 @@ class _Problem(eqx.Module):
             )
             return sol.ys, sol.status
 
-        return jax.vmap(one)(s, ts)
+        return _map1(jax.vmap, lambda a: one(*a), (s, ts))
 
     def simulate_windows(self, z) -> tuple[Array, Array]:
         """States (R, K, n+1, 13) in every window of every record, and the solver status (R, K)."""
         p = self.params(z["params"])
         rec = self.rec
         _, off = self.sensor(z)
-        return jax.lax.map(
+        return _map1(
+            jax.lax.map,
             lambda a: self._simulate_record(self._record_params(p, a[3], a[4]), a[0], a[1], a[2] + a[5]),
             (z["states"], rec.fixed_states, rec.ts, rec.omega_pi, rec.q_pi, off),
         )
@@ -305,7 +317,8 @@ class _Problem(eqx.Module):
 
         # records one after another in one traced body (lax.map): on CPU a vmapped adaptive solve
         # steps every lane until the slowest is done, at several times the cost of a sequence
-        rm, rp = jax.lax.map(
+        rm, rp = _map1(
+            jax.lax.map,
             lambda a: one(*a),
             (z["states"], rec.fixed_states, rec.ts, rec.omega_pi, rec.q_pi, rec.obs, rec.mask, rec.inv_sigma, off),
         )
@@ -349,8 +362,11 @@ class _Problem(eqx.Module):
             "states": zf[P + nr + no :].reshape(R, k, 13),
         }
 
-    def flatten(self, z: dict) -> Array:
-        return jnp.concatenate([z["params"], z["rotation"], z["offsets"], z["states"].reshape(-1)])
+    def flatten(self, z: dict) -> np.ndarray:
+        """The flat vector of host values ``z`` (the inverse of `unflatten`), on the host."""
+        return np.concatenate(
+            [np.asarray(z[k], float).reshape(-1) for k in ("params", "rotation", "offsets", "states")]
+        )
 
     def value_and_jacobian(self, zf: Array) -> tuple[Array, Array]:
         """r (M,) and the forward-mode Jacobian dr/dz (M, len(zf)) in one batched JVP pass."""
@@ -463,6 +479,12 @@ class FitResult:
 
 
 # ----------------------------------------------------------------------------- building
+def _dev(x) -> Array:
+    """A float64 host value on the default device, without compiling anything (``jnp.asarray``
+    of a host array compiles a copy program per shape: tens of ms each, eagerly)."""
+    return jax.device_put(np.asarray(x, dtype=float))
+
+
 def _build(
     data: MeasuredData,
     params0: CeltParams,
@@ -495,7 +517,7 @@ def _build(
         raise ValueError(f"fit: windows must be >= 1, got {windows}")
     if window_states not in ("data", "optimise"):
         raise ValueError(f"fit: window_states must be 'data' or 'optimise', got {window_states!r}")
-    theta0 = jnp.stack([jnp.asarray(getattr(params0, n), float) for n in free])
+    theta0 = _dev([float(getattr(params0, n)) for n in free])
     kinds_all: set[str] = set()
     per = []
     for it, tr in enumerate(data.trajectories):
@@ -569,25 +591,25 @@ def _build(
     if (fit_rotation or fit_time_offset) and not (set(kinds) & set(SENSOR_KINDS)):
         raise ValueError(f"fit: fit_rotation/fit_time_offset need sensor observations {SENSOR_KINDS}, have {kinds}")
     rec = _Record(
-        ts=jnp.asarray(ts),
-        obs={k: jnp.asarray(v) for k, v in obs.items()},
-        mask={k: jnp.asarray(v) for k, v in mask.items()},
-        inv_sigma={k: jnp.asarray(v) for k, v in inv_sigma.items()},
-        fixed_states=jnp.asarray(fixed),
-        omega_pi=jnp.asarray([tr.omega_pi for tr, _, _ in per], float),
-        q_pi=jnp.asarray([tr.q_pi for tr, _, _ in per], float),
-        rotation0=jnp.asarray(rv0),
-        offset0=jnp.asarray(np.array(off0)),
+        ts=_dev(ts),
+        obs={k: _dev(v) for k, v in obs.items()},
+        mask={k: _dev(v) for k, v in mask.items()},
+        inv_sigma={k: _dev(v) for k, v in inv_sigma.items()},
+        fixed_states=_dev(fixed),
+        omega_pi=_dev([float(tr.omega_pi) for tr, _, _ in per]),
+        q_pi=_dev([float(tr.q_pi) for tr, _, _ in per]),
+        rotation0=_dev(rv0),
+        offset0=_dev(off0),
         free_windows=tuple(free_w),
     )
-    z_states = jnp.asarray(fixed[:, free_w] / STATE_SCALE) if free_w else jnp.zeros((R, 0, 13))
-    w = {k: jnp.asarray(float(weights.get(k, 1.0))) for k in kinds}
+    z_states = _dev(fixed[:, free_w] / STATE_SCALE if free_w else np.zeros((R, 0, 13)))
+    w = {k: _dev(float(weights.get(k, 1.0))) for k in kinds}
     prob = _Problem(
         params0=params0,
         theta0=theta0,
         rec=rec,
         weights=w,
-        continuity_weight=jnp.asarray(float(continuity_weight)),
+        continuity_weight=_dev(float(continuity_weight)),
         free=tuple(free),
         transforms=tuple(trs),
         kinds=kinds,
@@ -599,25 +621,27 @@ def _build(
         fit_time_offset=bool(fit_time_offset),
     )
     z0 = {
-        "params": jnp.zeros(len(free)),
-        "rotation": jnp.zeros(3 if fit_rotation else 0),
-        "offsets": jnp.zeros(R if fit_time_offset else 0),
+        "params": np.zeros(len(free)),
+        "rotation": np.zeros(3 if fit_rotation else 0),
+        "offsets": np.zeros(R if fit_time_offset else 0),
         "states": z_states,
     }
     return prob, z0
 
 
 @eqx.filter_jit
-def _theta_and_jacobian(prob: _Problem, zp: Array) -> tuple[Array, Array]:
-    """Physical values of the free parameters and d theta / d z at zp, in one small compiled program
-    (eager, the transforms' operations and their derivatives cost a compilation each)."""
+def _theta_and_jacobian(prob: _Problem, zf: Array) -> tuple[Array, Array]:
+    """Physical values of the free parameters and d theta / d z at the flat unknowns zf, in one
+    small compiled program (eager, the transforms' operations and their derivatives and the slice
+    would cost a compilation each)."""
+    zp = zf[: len(prob.free)]
     return prob.theta(zp), jax.jacfwd(prob.theta)(zp)
 
 
 @eqx.filter_jit
-def _thetas(prob: _Problem, zps: Array) -> Array:
-    """Physical values of the free parameters of a batch of starts (S, P)."""
-    return jax.vmap(prob.theta)(zps)
+def _thetas(prob: _Problem, zfs: Array) -> Array:
+    """Physical values of the free parameters of a batch of starts (S, n)."""
+    return jax.vmap(prob.theta)(zfs[:, : len(prob.free)])
 
 
 # ----------------------------------------------------------------------------- optimisers (jitted once per shape)
@@ -636,6 +660,9 @@ def _value_and_jacobian(prob: _Problem, zf):
 # optimiser, the uncertainty, multi-start and profile likelihood. The optimisers' own (small)
 # programs reach it through `jax.pure_callback`, so they never contain the solver and are compiled
 # in about a second, once per (residual length, unknowns, optimiser) for the whole process.
+EVALUATION_COMPILER_OPTIONS = {"xla_cpu_use_fusion_emitters": False}
+"""XLA options of the evaluation program on a CPU: XLA's older loop emitters compile it in about
+60 % of the time of its fusion emitters (``benchmarks/fit_compile_parts.py``)."""
 _ACTIVE: list = [None]  # the problem the callbacks evaluate (set by `fit`; not thread-safe)
 _COMPILE_LOCK = threading.Lock()
 _SPLIT: list = [None, None]  # the last problem `_evaluate` split into records, and its parts
@@ -657,7 +684,7 @@ def _one_record(prob: _Problem, i: int) -> tuple[_Problem, np.ndarray, np.ndarra
     """Record ``i`` as a problem of its own, the columns of its unknowns in the flat vector and the
     rows of its residuals (misfit block, then penalty block) in the whole problem's residuals."""
     rec, R = prob.rec, prob.n_records
-    cut = lambda a: a[i : i + 1]  # noqa: E731
+    cut = lambda a: _dev(np.asarray(a)[i : i + 1])  # noqa: E731  (host slicing: no eager program)
     sub_rec = dataclasses.replace(
         rec,
         ts=cut(rec.ts),
@@ -680,16 +707,35 @@ def _one_record(prob: _Problem, i: int) -> tuple[_Problem, np.ndarray, np.ndarra
     return sub, cols, rows
 
 
-def _evaluate(prob: _Problem, zf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(r, J) at zf (n,) or at a batch of unknowns (..., n). On a CPU with several cores, records
-    are evaluated in parallel threads, each by the one-record program (the records share its
-    shapes); otherwise all records by one program (`jax.lax.map`)."""
+def _parts(prob: _Problem) -> list[tuple[_Problem, np.ndarray, np.ndarray]] | None:
+    """How `_evaluate` splits ``prob``: on a CPU with several cores, one part per record (see
+    `_one_record`), evaluated in parallel threads by the one-record program (the records share
+    its shapes); None: all records by one program (`jax.lax.map`)."""
     R, workers = prob.n_records, min(prob.n_records, _cpu_workers())
     if R == 1 or workers == 1 or jax.default_backend() != "cpu":
-        return _evaluate_program(prob, zf)
+        return None
     if _SPLIT[0] is not prob:  # the split is per problem (one fit evaluates it many times)
         _SPLIT[:] = [prob, [_one_record(prob, i) for i in range(R)]]
-    parts = _SPLIT[1]
+    return _SPLIT[1]
+
+
+def _prefetch(prob: _Problem, zf: np.ndarray) -> None:
+    """Start compiling the evaluation program `_evaluate` will run at unknowns shaped like ``zf``
+    in the background (traced now), so that the optimiser's own programs are traced and compiled
+    meanwhile."""
+    parts = _parts(prob)
+    if parts is None:
+        _evaluate_program(prob, zf, background=True)
+    else:  # the records share one program
+        _evaluate_program(parts[0][0], zf[..., parts[0][1]], background=True)
+
+
+def _evaluate(prob: _Problem, zf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(r, J) at zf (n,) or at a batch of unknowns (..., n), split as `_parts` says."""
+    parts = _parts(prob)
+    if parts is None:
+        return _evaluate_program(prob, zf)
+    workers = min(prob.n_records, _cpu_workers())
     outs = list(_record_pool(workers).map(lambda part: _evaluate_program(part[0], zf[..., part[1]]), parts))
     r = np.empty((*zf.shape[:-1], prob.n_residuals))
     J = np.zeros((*zf.shape[:-1], prob.n_residuals, zf.shape[-1]))
@@ -699,16 +745,18 @@ def _evaluate(prob: _Problem, zf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return r, J
 
 
-def _evaluate_program(prob: _Problem, zf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _evaluate_program(prob: _Problem, zf: np.ndarray, background: bool = False):
     """(r, J) by the compiled evaluation program of ``prob``'s shape (one per batch shape), kept
     in memory and -- with JAX's persistent cache directory set -- on disk across processes
     (`jaxcelt._executable_cache`). Traced without equinox's error callbacks (save times are
-    checked by `_build`): a failing solve gives NaN."""
+    checked by `_build`): a failing solve gives NaN. ``background``: only start compiling it
+    (`jaxcelt._executable_cache.compile_in_background`); returns None."""
     prob = dataclasses.replace(prob, mode="fwd")
     dyn, static = eqx.partition(prob, eqx.is_array)
     leaves, treedef = jax.tree.flatten(dyn)
+    zf = np.asarray(zf, dtype=float)
     lead, n = zf.shape[:-1], zf.shape[-1]
-    x = jnp.asarray(zf.reshape(-1, n) if lead else zf)
+    x = _dev(zf.reshape(-1, n) if lead else zf)
 
     def f(leaves, x):
         pr = eqx.combine(jax.tree.unflatten(treedef, leaves), static)
@@ -716,7 +764,10 @@ def _evaluate_program(prob: _Problem, zf: np.ndarray) -> tuple[np.ndarray, np.nd
 
     description = repr(jax.tree.structure(prob)) + repr(jax.tree.leaves(static))
     with _COMPILE_LOCK, runtime_checks_as_nan():  # one thread traces (the context swaps a global)
-        exe = compiled("fit-residuals-jacobian", f, (leaves, x), description)
+        opts = EVALUATION_COMPILER_OPTIONS if jax.default_backend() == "cpu" else None
+        if background:
+            return compile_in_background("fit-residuals-jacobian", f, (leaves, x), description, opts)
+        exe = compiled("fit-residuals-jacobian", f, (leaves, x), description, opts)
     r, J = (np.asarray(a) for a in exe(leaves, x))
     return (r.reshape(*lead, -1), J.reshape(*lead, -1, n)) if lead else (r, J)
 
@@ -802,8 +853,8 @@ def _lsq_step(z, state, solver, m):
     fn = _lsq_fn(m)
     z, state, _ = solver.step(fn, z, None, {}, state, frozenset())
     done, result = solver.terminate(fn, z, None, {}, state, frozenset())
-    # loss at the last accepted iterate
-    return z, state, 0.5 * jnp.sum(state.f_info.residual**2), done, result
+    # loss at the last accepted iterate; whether the termination is a success
+    return z, state, 0.5 * jnp.sum(state.f_info.residual**2), done, result == optx.RESULTS.successful
 
 
 @eqx.filter_jit
@@ -816,11 +867,11 @@ def _lsq_step_batch(zs, states, frozen, solver, m):
     """One step of every start; a start that has terminated (``frozen``) keeps its iterate and state."""
 
     def one(z, state, stop):
-        z2, state2, loss, done, result = _lsq_step(z, state, solver, m)
+        z2, state2, loss, done, ok = _lsq_step(z, state, solver, m)
         keep = lambda a, b: jnp.where(stop, a, b) if eqx.is_array(a) else b  # noqa: E731
         z2 = jnp.where(stop, z, z2)
         state2 = jax.tree.map(keep, state, state2, is_leaf=lambda x: x is None)
-        return z2, state2, loss, done, result == optx.RESULTS.successful
+        return z2, state2, loss, done, ok
 
     return eqx.filter_vmap(one)(zs, states, frozen)
 
@@ -918,7 +969,7 @@ def fit(
     t_start = time.perf_counter()
 
     def values_of(zf) -> dict[str, float]:
-        th = np.asarray(_theta_and_jacobian(prob, zf[:P])[0])
+        th = np.asarray(_theta_and_jacobian(prob, zf)[0])
         return {n: float(th[i]) for i, n in enumerate(free)}
 
     loss_hist, par_hist = [], []
@@ -926,9 +977,10 @@ def fit(
     iter_marks = [time.perf_counter()]
     if optimiser in LSQ_OPTIMISERS:
         solver = _lsq_solver(optimiser, rtol, atol)
+        _prefetch(prob, zf)
         state = _lsq_init(zf, solver, m)
         for it in range(max_iter):
-            z_new, state, loss_acc, done, result = _lsq_step(zf, state, solver, m)
+            z_new, state, loss_acc, done, ok = _lsq_step(zf, state, solver, m)
             jax.block_until_ready(z_new)
             iter_marks.append(time.perf_counter())
             zf = z_new
@@ -937,7 +989,7 @@ def fit(
             if callback is not None:
                 callback(it, loss_hist[-1], par_hist[-1])
             if bool(done):
-                converged = result == optx.RESULTS.successful
+                converged = bool(ok)
                 break
             if max_time is not None and iter_marks[-1] - t_start > max_time:
                 break
@@ -948,6 +1000,7 @@ def fit(
             opt = optax.adam(optax.cosine_decay_schedule(learning_rate, max_iter, alpha=1e-3))
         else:
             opt = optax.lbfgs()
+        _prefetch(prob, zf)
         opt_state = opt.init(zf)
         g0 = None
         for it in range(max_iter):
@@ -1018,20 +1071,22 @@ def _split_times(iter_marks: list[float]) -> tuple[float, float]:
 
 def _result(prob, zf, r, Jflat, a, loss_hist, par_hist, converged, compile_time, wall, t_start) -> FitResult:
     """`FitResult` at the final unknowns ``zf`` with residuals ``r`` and Jacobian ``Jflat`` there."""
+    # on the host or in compiled programs: eager jnp operations would compile one program each
     free, P = prob.free, len(prob.free)
-    zf = jnp.asarray(zf)
-    th, dth = (np.asarray(a) for a in _theta_and_jacobian(prob, zf[:P]))
+    zf = np.asarray(zf, dtype=float)
+    th, dth = (np.asarray(a) for a in _theta_and_jacobian(prob, zf))
     values = {n: float(th[i]) for i, n in enumerate(free)}
     z = prob.unflatten(zf)
-    n_data = int(sum(float(jnp.sum(prob.rec.mask[k])) * OBSERVABLES[k] for k in prob.kinds))
+    mask = {k: np.asarray(prob.rec.mask[k]) for k in prob.kinds}
+    n_data = int(sum(float(np.sum(mask[k])) * OBSERVABLES[k] for k in prob.kinds))
     if prob.rec.ts.shape[1] > 1:  # shared window boundary samples are counted once
-        n_data -= int(sum(float(jnp.sum(prob.rec.mask[k][:, 1:, 0])) * OBSERVABLES[k] for k in prob.kinds))
+        n_data -= int(sum(float(np.sum(mask[k][:, 1:, 0])) * OBSERVABLES[k] for k in prob.kinds))
     nm = prob.n_misfit
     misfit, cont = float(np.sum(r[:nm] ** 2)), float(np.sum(r[nm:] ** 2))
     loss_hist = [*loss_hist, 0.5 * (misfit + cont)]
     par_hist = [*par_hist, values]
     n_unk = int(zf.size)
-    rv_fit, off_fit = (np.asarray(x) for x in prob.sensor(z))
+    rv_fit, off_fit = prob.sensor(z, xp=np)
     nuisance: dict[str, Any] = {"rotation_vector": rv_fit.tolist(), "time_offset": off_fit.tolist()}
     stderr = dict.fromkeys(free, np.nan)
     ci = {n: (np.nan, np.nan) for n in free}
@@ -1066,7 +1121,7 @@ def _result(prob, zf, r, Jflat, a, loss_hist, par_hist, converged, compile_time,
     return FitResult(
         free=free,
         values=values,
-        params=prob.params(z["params"]),
+        params=eqx.tree_at(lambda p: [getattr(p, n) for n in free], prob.params0, [_dev(th[i]) for i in range(P)]),
         stderr=stderr,
         ci95=ci,
         corr=corr,
@@ -1254,7 +1309,7 @@ def _fit_batch(
 ) -> list[FitResult]:
     """Least-squares fits from every guess at once (see `multistart`)."""
     prob, zf0 = _prepare(data, params0, a)
-    free, P, m = prob.free, len(prob.free), prob.n_residuals
+    free, m = prob.free, prob.n_residuals
     starts = np.repeat(np.asarray(zf0)[None], len(guesses), axis=0)
     for i, g in enumerate(guesses):
         for name, v in g.items():
@@ -1268,19 +1323,20 @@ def _fit_batch(
     _ACTIVE[0] = prob
     t_start = time.perf_counter()
     S = len(guesses)
-    zs = jnp.asarray(starts)
+    zs = _dev(starts)
     solver = _lsq_solver(a["optimiser"], a["rtol"], a["atol"])
+    _prefetch(prob, starts)
     states = _lsq_init_batch(zs, solver, m)
     frozen, converged = np.zeros(S, bool), np.zeros(S, bool)
     loss_hist: list[list[float]] = [[] for _ in range(S)]
     par_hist: list[list[dict]] = [[] for _ in range(S)]
     iter_marks = [time.perf_counter()]
     for it in range(a["max_iter"]):
-        zs, states, loss, done, ok = _lsq_step_batch(zs, states, jnp.asarray(frozen), solver, m)
+        zs, states, loss, done, ok = _lsq_step_batch(zs, states, jax.device_put(frozen), solver, m)
         jax.block_until_ready(zs)
         iter_marks.append(time.perf_counter())
         loss, done, ok = np.asarray(loss), np.asarray(done), np.asarray(ok)
-        th = np.asarray(_thetas(prob, zs[:, :P]))
+        th = np.asarray(_thetas(prob, zs))
         for i in np.flatnonzero(~frozen):
             loss_hist[i].append(float(loss[i]))
             par_hist[i].append({n: float(th[i, j]) for j, n in enumerate(free)})

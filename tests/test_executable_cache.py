@@ -135,3 +135,39 @@ def test_second_process_loads_the_fit_program(tmp_path):
     assert outs[0]["lowered"] == 1 and outs[1]["lowered"] == 0
     for k in ("r", "J"):
         np.testing.assert_allclose(outs[1][k], outs[0][k], rtol=1e-12, atol=1e-300)
+
+
+def test_background_compilation_is_waited_for_and_stored(cache, monkeypatch):
+    """`compile_in_background` lowers once; `compiled` then waits for that program (no second
+    lowering), which is stored like a synchronous compilation and gives the same values."""
+    traced = _traced(monkeypatch)
+    args = _args()
+    want = np.sin(np.linspace(0.0, 1.0, 3)) * 2.0 + np.arange(3.0)
+    assert ec.compile_in_background("t", _f, args, "sin") is None
+    ec.compile_in_background("t", _f, args, "sin")  # already started: nothing new
+    exe = ec.compiled("t", _f, args, "sin")
+    assert len(traced) == 1
+    np.testing.assert_allclose(np.asarray(exe(*args)), want, rtol=0, atol=1e-15)
+    assert len(list(cache.glob("*.bin"))) == 1
+    ec._MEMORY.clear()  # a new process: loaded from the file, not lowered
+    ec.compile_in_background("t", _f, args, "sin")
+    assert len(traced) == 1 and not hasattr(ec._MEMORY[next(iter(ec._MEMORY))], "result")
+
+
+def test_background_compilation_error_reaches_the_caller(cache, monkeypatch):
+    """An XLA compilation that fails on the worker thread raises where `compiled` is called, and
+    nothing is stored."""
+
+    class Lowered:
+        def compile(self, options=None):
+            raise RuntimeError("XLA compilation failed")
+
+    class Jitted:
+        def lower(self, *args):
+            return Lowered()
+
+    monkeypatch.setattr(ec.jax, "jit", lambda fn: Jitted())
+    ec.compile_in_background("t", _f, _args(), "sin")
+    with pytest.raises(RuntimeError, match="XLA compilation failed"):
+        ec.compiled("t", _f, _args(), "sin")
+    assert not list(cache.glob("*.bin"))

@@ -308,9 +308,10 @@ def test_cli_fit_csv_round_trip(tmp_path, short_imu, capsys):
     assert out["param_history"][0]["mu"] == pytest.approx(0.25, rel=1e-12)
     assert out["param_history"][0]["k_r"] == pytest.approx(0.35, rel=1e-12)
     assert out["param_history"][0]["b_Ts"] == pytest.approx(float(PAPER.b_Ts), rel=1e-12)
-    # LM reports the loss at its accepted iterate: never increasing
+    # LM reports the loss at its accepted iterate: never increasing. The last entry is the final
+    # loss summed on the host (another summation order than LM's): equal within 1e-12 relative
     h = out["loss_history"]
-    assert all(b <= a for a, b in zip(h, h[1:], strict=False)) and out["n_iter"] == 4
+    assert all(b <= a * (1 + 1e-12) for a, b in zip(h, h[1:], strict=False)) and out["n_iter"] == 4
 
 
 @pytest.mark.slow
