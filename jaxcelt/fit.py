@@ -52,6 +52,7 @@ import optax
 import optimistix as optx
 
 from . import _config  # noqa: F401
+from ._compile_options import compiler_options
 from ._diffrax_adapter import runtime_checks_as_nan
 from ._executable_cache import compile_in_background, compiled
 from ._types import Array, State
@@ -660,9 +661,6 @@ def _value_and_jacobian(prob: _Problem, zf):
 # optimiser, the uncertainty, multi-start and profile likelihood. The optimisers' own (small)
 # programs reach it through `jax.pure_callback`, so they never contain the solver and are compiled
 # in about a second, once per (residual length, unknowns, optimiser) for the whole process.
-EVALUATION_COMPILER_OPTIONS = {"xla_cpu_use_fusion_emitters": False}
-"""XLA options of the evaluation program on a CPU: XLA's older loop emitters compile it in about
-60 % of the time of its fusion emitters (``benchmarks/fit_compile_parts.py``)."""
 _ACTIVE: list = [None]  # the problem the callbacks evaluate (set by `fit`; not thread-safe)
 _COMPILE_LOCK = threading.Lock()
 _SPLIT: list = [None, None]  # the last problem `_evaluate` split into records, and its parts
@@ -764,7 +762,7 @@ def _evaluate_program(prob: _Problem, zf: np.ndarray, background: bool = False):
 
     description = repr(jax.tree.structure(prob)) + repr(jax.tree.leaves(static))
     with _COMPILE_LOCK, runtime_checks_as_nan():  # one thread traces (the context swaps a global)
-        opts = EVALUATION_COMPILER_OPTIONS if jax.default_backend() == "cpu" else None
+        opts = compiler_options(jax.default_backend())
         if background:
             return compile_in_background("fit-residuals-jacobian", f, (leaves, x), description, opts)
         exe = compiled("fit-residuals-jacobian", f, (leaves, x), description, opts)

@@ -21,6 +21,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .. import _config  # noqa: F401
+from .._compile_options import compiler_options
 from .._types import Array
 from ..contact import get_contact_law
 from ..diagnostics import centre_position
@@ -180,10 +181,17 @@ def _pool_chunk(
     return shard_lanes(run, mesh, 3)(pb, y0b, live)
 
 
-@eqx.filter_jit
-def _lyap_chunk(pb: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig, mesh: Any) -> Array:
+def _lyap_chunk_impl(pb: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig, mesh: Any) -> Array:
     run = jax.vmap(lambda p, y, t: _lyap_lane(p, y, t, cfg))
     return shard_lanes(run, mesh, 3)(pb, y_start, t_start)
+
+
+# the Lyapunov stage (a diffrax solve with its tangent, vmapped over lanes), per platform: on a CPU
+# compiled with XLA's loop emitters (`jaxcelt._compile_options`)
+_lyap_chunk = {
+    platform: eqx.filter_jit(_lyap_chunk_impl, compiler_options=compiler_options(platform))
+    for platform in ("cpu", "other")
+}
 
 
 def run_lanes_with_stats(
@@ -250,7 +258,7 @@ def run_lanes_with_stats(
         G = Wd * ndev  # the pool's width: a chunk of few lanes solves no padding copies
         for i in range(0, len(ok), G):
             idx = pad_lanes(ok[i : i + G], G)
-            lam = _lyap_chunk(
+            lam = _lyap_chunk["cpu" if platform == "cpu" else "other"](
                 jax.tree_util.tree_map(lambda x, idx=idx: x[idx], pb_np),
                 out["samples"][idx, 0],  # float64 (a float32 pool's samples cast up)
                 out["t_samples"][idx, 0],
