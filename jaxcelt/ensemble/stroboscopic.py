@@ -10,7 +10,9 @@ processes are `jaxcelt.sweep`'s business.
 
 from __future__ import annotations
 
+import concurrent.futures
 import dataclasses
+import functools
 import math
 from collections.abc import Sequence
 from typing import Any
@@ -240,6 +242,14 @@ def run_lanes_with_stats(
     # conditional costs a device-to-host sync per stage, so none there
     platform = (list(devices)[0] if devices else jax.local_devices()[0]).platform
     opaque_true = jnp.asarray(True) if platform == "cpu" else None
+    G = Wd * ndev  # the Lyapunov stage's chunk: the pool's width (a chunk of few lanes solves no padding copies)
+    lyap_fn = _lyap_chunk["cpu" if platform == "cpu" else "other"]
+    lyap_compiled = None
+    if cfg.lyapunov_periods > 0 and not compile_only:
+        # its shapes are known now: traced here, compiled by XLA on a worker thread while the pool
+        # is traced, compiled and run (one XLA compilation uses one core)
+        example = (jax.tree_util.tree_map(lambda x: x[:1].repeat(G, 0), pb_np), np.zeros((G, 13)), np.zeros(G))
+        lyap_compiled = _background_compiler().submit(lyap_fn.lower(*example, static_cfg, mesh).compile)
     out, iters, slot_steps = _pool_chunk(
         pb_p, y0_np[pos_lane].astype(dt), live, jnp.asarray(frac), transient, tols, nocfg, Wd, mesh, vary, opaque_true
     )
@@ -255,10 +265,10 @@ def run_lanes_with_stats(
     if cfg.lyapunov_periods > 0 and not compile_only:
         ok = np.flatnonzero(out["status"] == 0)
         ok = ok[np.argsort(-out["num_steps"][ok], kind="stable")]  # similar cost side by side
-        G = Wd * ndev  # the pool's width: a chunk of few lanes solves no padding copies
+        lyap = lyap_compiled.result()
         for i in range(0, len(ok), G):
             idx = pad_lanes(ok[i : i + G], G)
-            lam = _lyap_chunk["cpu" if platform == "cpu" else "other"](
+            lam = lyap(
                 jax.tree_util.tree_map(lambda x, idx=idx: x[idx], pb_np),
                 out["samples"][idx, 0],  # float64 (a float32 pool's samples cast up)
                 out["t_samples"][idx, 0],
@@ -268,6 +278,11 @@ def run_lanes_with_stats(
             n = min(G, len(ok) - i)
             out["lyapunov"][idx[:n]] = np.asarray(lam)[:n]
     return out, stats
+
+
+@functools.cache
+def _background_compiler() -> concurrent.futures.ThreadPoolExecutor:
+    return concurrent.futures.ThreadPoolExecutor(max_workers=1, thread_name_prefix="jaxcelt-lyapunov-compile")
 
 
 def run_lanes(
