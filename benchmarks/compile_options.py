@@ -1,15 +1,12 @@
-"""XLA's CPU loop emitters vs its fusion emitters for the main job's Lyapunov stage and its
-orbits (writes docs/performance/compile_options.json).
+"""XLA's CPU loop emitters vs its fusion emitters for the main job's Lyapunov stage (writes
+docs/performance/compile_options.json).
 
 The main job's lanes (60 omega_pi values in [10, 20] rad/s from rest, paper's parameters,
 100 transient periods, stop at invalid states, Tsit5 rtol 1e-8) run through the pool without
 Lyapunov exponents; then the Lyapunov stage (30 periods of tangent dynamics, as
 ``jaxcelt bifurcation`` runs it) is traced, compiled and run with XLA's default options and with
 ``jaxcelt._compile_options.LOOP_EMITTERS``, each in a fresh process: trace + lowering, XLA
-compilation, the best of 3 runs, and the exponents (the two programs agree to rounding). Then
-one of the main job's phase-plot orbits (`jaxcelt.sweep.orbit` at omega_pi = 17 rad/s: 100
-transient + 40 periods, 40 points per period), whose `jaxcelt.simulate` program is compiled with
-the same options: the first call (tracing, compilation and the run) and the best of 3 later ones.
+compilation, the best of 3 runs, and the exponents (the two programs agree to rounding).
 
     .venv/bin/python benchmarks/compile_options.py [--out docs/performance/compile_options.json]
 """
@@ -64,24 +61,9 @@ def child(variant: str) -> dict:
         lam = np.asarray(jax.block_until_ready(compiled(*args)))
         runs.append(time.perf_counter() - t)
     n = min(G, len(ok))
-    # the orbit: simulate's program compiled with this variant's options
-    from jaxcelt import solve
-    from jaxcelt.sweep import orbit
-
-    solve._SOLVE["cpu"] = eqx.filter_jit(solve._solve, compiler_options=LOOP_EMITTERS if variant == "loop" else None)
-    pw = p.replace(omega_pi=17.0)
-    t = time.perf_counter()
-    o = orbit(pw, jc.initial_state(pw), transient_periods=100, periods=40)
-    first = time.perf_counter() - t
-    oruns = []
-    for _ in range(3):
-        t = time.perf_counter()
-        orbit(pw, jc.initial_state(pw), transient_periods=100, periods=40)
-        oruns.append(time.perf_counter() - t)
     return dict(
         variant=variant, lanes=int(n), trace_lower_s=trace_s, compile_s=compile_s, run_best_of_3_s=min(runs),
-        lyapunov=lam[:n].tolist(), orbit_first_call_s=first, orbit_run_best_of_3_s=min(oruns),
-        orbit_ys_last=o["ys"][-1].tolist(),
+        lyapunov=lam[:n].tolist(),
     )  # fmt: skip
 
 
@@ -109,8 +91,6 @@ def main(argv=None) -> int:
     res["lyapunov_max_abs_diff"] = float(np.max(np.abs(d - lp)))
     res["compile_ratio_loop_over_default"] = res["runs"]["loop"]["compile_s"] / res["runs"]["default"]["compile_s"]
     res["run_ratio_loop_over_default"] = res["runs"]["loop"]["run_best_of_3_s"] / res["runs"]["default"]["run_best_of_3_s"]
-    od, ol = (np.asarray(res["runs"][v]["orbit_ys_last"]) for v in ("default", "loop"))
-    res["orbit_last_state_max_abs_diff"] = float(np.max(np.abs(od - ol)))
     res["load_average_at_end"] = os.getloadavg()
     a.out.parent.mkdir(parents=True, exist_ok=True)
     a.out.write_text(json.dumps(res, indent=1))

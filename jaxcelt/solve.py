@@ -23,7 +23,6 @@ import numpy as np
 import optimistix as optx
 
 from . import _config  # noqa: F401
-from ._compile_options import compiler_options
 from ._diffrax_adapter import use_stepsize_tol
 from ._types import Array, ArrayLike, Scalar
 from .contact import AbstractContactLaw, get_contact_law
@@ -275,6 +274,7 @@ def _fill_implicit_tols(solver, rtol, atol):
     return solver
 
 
+@eqx.filter_jit
 def _solve(
     params: CeltParams,
     y0: Array,
@@ -347,12 +347,6 @@ def _as_float(x, dtype, name, scalar=False):
     if not isinstance(a, jax.core.Tracer) and not np.all(np.isfinite(np.asarray(a))):
         raise ValueError(f"{name!r} must be finite, got {np.asarray(a)}")
     return a
-
-
-# `_solve` compiled per platform: on a CPU with XLA's loop emitters (`jaxcelt._compile_options`)
-_SOLVE = {
-    platform: eqx.filter_jit(_solve, compiler_options=compiler_options(platform)) for platform in ("cpu", "other")
-}
 
 
 def simulate(
@@ -447,7 +441,7 @@ def simulate(
         solver = eqx.tree_at(lambda s: s.scan_kind, solver, "lax", is_leaf=lambda x: x is None)
     if dtype == jnp.dtype(jnp.float32):
         params = jax.tree_util.tree_map(lambda x: jnp.asarray(x, jnp.float32), params)
-    return _SOLVE["cpu" if jax.default_backend() == "cpu" else "other"](
+    return _solve(
         params,
         y0a,
         t0a,

@@ -244,15 +244,17 @@ def run_lanes_with_stats(
     opaque_true = jnp.asarray(True) if platform == "cpu" else None
     G = Wd * ndev  # the Lyapunov stage's chunk: the pool's width (a chunk of few lanes solves no padding copies)
     lyap_fn = _lyap_chunk["cpu" if platform == "cpu" else "other"]
+    # The pool's program and the Lyapunov stage's are traced here, one after the other, and
+    # compiled by XLA on worker threads at the same time (one XLA compilation uses one core); both
+    # are then called as compiled programs. Later chunks of the same shapes find them in JAX's caches.
+    pool_args = (pb_p, y0_np[pos_lane].astype(dt), live, jnp.asarray(frac), transient, tols, nocfg, Wd, mesh, vary,
+                 opaque_true)  # fmt: skip
+    pool_compiled = _background_compiler().submit(_pool_chunk.lower(*pool_args).compile)
     lyap_compiled = None
     if cfg.lyapunov_periods > 0 and not compile_only:
-        # its shapes are known now: traced here, compiled by XLA on a worker thread while the pool
-        # is traced, compiled and run (one XLA compilation uses one core)
         example = (jax.tree_util.tree_map(lambda x: x[:1].repeat(G, 0), pb_np), np.zeros((G, 13)), np.zeros(G))
         lyap_compiled = _background_compiler().submit(lyap_fn.lower(*example, static_cfg, mesh).compile)
-    out, iters, slot_steps = _pool_chunk(
-        pb_p, y0_np[pos_lane].astype(dt), live, jnp.asarray(frac), transient, tols, nocfg, Wd, mesh, vary, opaque_true
-    )
+    out, iters, slot_steps = pool_compiled.result()(*pool_args)
     stats = PoolStats(iterations=int(np.asarray(iters).max()), slot_steps=int(np.sum(np.asarray(slot_steps))), width=Wd)
     out = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(out))
     inv = np.empty_like(pos_lane)
@@ -282,7 +284,7 @@ def run_lanes_with_stats(
 
 @functools.cache
 def _background_compiler() -> concurrent.futures.ThreadPoolExecutor:
-    return concurrent.futures.ThreadPoolExecutor(max_workers=1, thread_name_prefix="jaxcelt-lyapunov-compile")
+    return concurrent.futures.ThreadPoolExecutor(max_workers=2, thread_name_prefix="jaxcelt-compile")
 
 
 def run_lanes(

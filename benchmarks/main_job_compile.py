@@ -1,0 +1,89 @@
+"""What compilation costs the main job (writes docs/bifurcation/main_job_compile.json).
+
+Runs ``jaxcelt bifurcation`` (the quick start's main job: the paper's defaults, with figures)
+twice in one fresh process with JAX's persistent cache off (``JAXCELT_CACHE_DIR=off``): the first
+run compiles every program, the second finds them compiled in the process. The difference of
+the two is what compilation adds to the run (tracing and XLA compilation on the critical path,
+less whatever overlaps with other work). Reported for the sweep (``wall_seconds_including_compile``
+of each run's summary.json) and for the whole command; matplotlib is imported before the first
+run, so that its import is not counted. Also the tracing and XLA compilation times JAX logs
+(``jax_log_compiles``) for the programs that take more than 0.2 s.
+
+    .venv/bin/python benchmarks/main_job_compile.py [--out docs/bifurcation/main_job_compile.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import os
+import re
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, default=Path("docs/bifurcation/main_job_compile.json"))
+    a = ap.parse_args(argv)
+    os.environ["JAXCELT_CACHE_DIR"] = "off"
+    import jax
+    import matplotlib.pyplot  # noqa: F401  (imported before the first run: not counted)
+
+    from jaxcelt.cli import main as cli
+    from jaxcelt.versions import versions
+
+    logged: list[tuple[str, float]] = []
+
+    class Collect(logging.Handler):
+        def emit(self, record):
+            m = re.match(r"Finished (.*) in ([0-9.]+) sec", record.getMessage())
+            if m:
+                logged.append((m[1], float(m[2])))
+
+    jax.config.update("jax_log_compiles", True)
+    for name in ("jax._src.dispatch", "jax._src.interpreters.pxla", "jax._src.compiler"):
+        lg = logging.getLogger(name)
+        lg.addHandler(Collect())
+        lg.setLevel(logging.DEBUG)
+        lg.propagate = False
+    # versions() after the runs: it starts JAX's backend, and the command sets the CPU device count first
+    res: dict = dict(cpu_count=os.cpu_count(), load_average_at_start=os.getloadavg(), runs=[])
+    with tempfile.TemporaryDirectory() as tmp:
+        for i in range(2):
+            out = Path(tmp) / f"run{i}"
+            n0 = len(logged)
+            t = time.perf_counter()
+            rc = cli(["bifurcation", "--out", str(out)])
+            whole = time.perf_counter() - t
+            summary = json.loads((out / "summary.json").read_text())
+            res["runs"].append(
+                dict(
+                    exit_code=rc,
+                    command_s=whole,
+                    sweep_s=summary["wall_seconds_including_compile"],
+                    regimes=summary["regimes"],
+                    logged_over_0_2_s=[(k, v) for k, v in logged[n0:] if v > 0.2],
+                    logged_total_s=sum(v for _, v in logged[n0:]),
+                )
+            )
+    res["versions"] = versions()
+    res["devices"] = len(jax.devices())
+    first, second = res["runs"]
+    res["sweep_compile_overhead_s"] = first["sweep_s"] - second["sweep_s"]
+    res["command_compile_overhead_s"] = first["command_s"] - second["command_s"]
+    res["same_regimes"] = first["regimes"] == second["regimes"]
+    res["load_average_at_end"] = os.getloadavg()
+    a.out.parent.mkdir(parents=True, exist_ok=True)
+    a.out.write_text(json.dumps(res, indent=1))
+    print(json.dumps({k: v for k, v in res.items() if k != "runs"}, indent=1))
+    for r in res["runs"]:
+        print(f"command {r['command_s']:.1f} s, sweep {r['sweep_s']:.1f} s; logged: {r['logged_over_0_2_s']}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
