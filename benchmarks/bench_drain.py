@@ -30,7 +30,6 @@ def main():
     a = ap.parse_args()
     jax.config.update("jax_num_cpu_devices", os.cpu_count() or 1)
     import jaxcelt as jc
-    from jaxcelt.ensemble import pool
     from jaxcelt.ensemble import stroboscopic as sb
     from jaxcelt.sweep import SweepConfig
     from jaxcelt.versions import versions
@@ -62,20 +61,15 @@ def main():
     res["schedules"] = {}
     long = None
     for name, (md, fac) in schedules.items():
-        # the widths are read when the pool is traced: drop every compiled program first
-        jax.clear_caches()
-        pool.run_pool.__kwdefaults__.update(min_drain_width=md, drain_factor=fac)
         res["schedules"][name] = dict(min_drain_width=md, drain_factor=fac)
         for stop in (True, False):
             cfg = SweepConfig(transient_periods=200, sample_periods=100, stop_on_invalid=stop)
-            out, r = run(vals, cfg, reps=3 if stop else 1)
+            out, r = run(vals, cfg, reps=3 if stop else 1, min_drain_width=md, drain_factor=fac)
             assert r["compile_s"] > 1.0, "a compiled program of another schedule was reused"
             res["schedules"][name]["stop_on_invalid" if stop else "integrate_on"] = r
             print(name, "stop" if stop else "on", r, flush=True)
             if not stop and long is None:
                 long = np.flatnonzero(out["status"] == 1)
-    pool.run_pool.__kwdefaults__.update(min_drain_width=pool.MIN_DRAIN_WIDTH, drain_factor=pool.DRAIN_FACTOR)
-    jax.clear_caches()
 
     # 1. per-iteration cost against the width, on the lanes that run longest
     lv = vals[long]

@@ -30,7 +30,17 @@ from ..diagnostics import centre_position
 from ..lyapunov import celt_lyapunov
 from ..params import PARAM_NAMES, CeltParams
 from ..solve import DEFAULT_SOLVER
-from .pool import DEFAULT_WIDTH, PILOT_FRACTION, PoolStats, lane_outputs, run_pool, split_lane_args, start_lanes
+from .pool import (
+    DEFAULT_WIDTH,
+    DRAIN_FACTOR,
+    MIN_DRAIN_WIDTH,
+    PILOT_FRACTION,
+    PoolStats,
+    lane_outputs,
+    run_pool,
+    split_lane_args,
+    start_lanes,
+)
 from .shard import device_mesh, pad_lanes, shard_lanes
 from .stepper import AbstractLaneStepper, erk_tableau, make_stepper
 
@@ -161,11 +171,13 @@ def _pool_chunk(
     mesh: Any,
     vary: tuple[bool, ...],
     opaque_true: Array | None,
+    drain: tuple[int, int] = (DRAIN_FACTOR, MIN_DRAIN_WIDTH),
 ) -> tuple[dict[str, Array], Array, Array]:
     """One chunk of lanes through the pool (per device): per-lane outputs and the loop counters.
 
     ``opaque_true``: a traced True (a jit argument: XLA would fold a constant predicate and the
-    fused step's kernel boundaries would vanish), or None: no kernel boundaries. ``vary``: `jaxcelt.ensemble.split_lane_args`."""
+    fused step's kernel boundaries would vanish), or None: no kernel boundaries. ``vary``: `jaxcelt.ensemble.split_lane_args`.
+    ``drain``: (drain factor, minimum drain width) of `run_pool`."""
 
     def run(pb, y0b, live):
         stepper = _stepper(cfg, opaque_true)
@@ -174,8 +186,9 @@ def _pool_chunk(
         t0 = jnp.asarray(cfg.t0, cfg.dtype)
         lanes, samples = start_lanes(stepper, pv_all, params_of, y0b, ts_all, live, tols, t0)
         lanes, samples, stats = run_pool(
-            stepper, lanes, samples, pv_all, params_of, ts_all, t0, width=width, pause_frac=pause_frac
-        )
+            stepper, lanes, samples, pv_all, params_of, ts_all, t0, width=width, pause_frac=pause_frac,
+            drain_factor=drain[0], min_drain_width=drain[1],
+        )  # fmt: skip
         out = dict(lane_outputs(stepper, lanes).as_dict(), samples=samples, t_samples=ts_all)
         out.update(jax.vmap(_extras)(samples, pb))
         return out, stats.iterations[None], stats.slot_steps[None]  # loop counters: one per device
@@ -207,9 +220,12 @@ def run_lanes_with_stats(
     compile_only: bool = False,
     varying: Sequence[str] = (),
     pilot_fraction: float = PILOT_FRACTION,
+    drain_factor: int = DRAIN_FACTOR,
+    min_drain_width: int = MIN_DRAIN_WIDTH,
 ) -> tuple[dict[str, np.ndarray], PoolStats]:
     """`run_lanes`, with the pool's statistics apart: (per-lane numpy arrays, `PoolStats` over
-    all devices: the busiest device's iterations, the step slots paid by all, the width)."""
+    all devices: the busiest device's iterations, the step slots paid by all, the width).
+    ``drain_factor``, ``min_drain_width``: the pool's drain schedule (`jaxcelt.ensemble.pool`)."""
     mesh = device_mesh(devices)
     L = int(np.shape(y0b)[0])
     ndev = 1 if mesh is None else mesh.devices.size
@@ -222,6 +238,9 @@ def run_lanes_with_stats(
     W = int(width or DEFAULT_WIDTH)
     if W < 1:
         raise ValueError(f"width must be >= 1, got {width!r}")
+    for name, v, lo in (("drain_factor", drain_factor, 2), ("min_drain_width", min_drain_width, 1)):
+        if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < lo:
+            raise ValueError(f"{name} must be an int >= {lo}, got {v!r}")
     nocfg = dataclasses.replace(static_cfg, lyapunov_periods=0)
     unknown = set(varying) - set(PARAM_NAMES)
     if unknown:
@@ -248,7 +267,7 @@ def run_lanes_with_stats(
     # compiled by XLA on worker threads at the same time (one XLA compilation uses one core); both
     # are then called as compiled programs. Later chunks of the same shapes find them in JAX's caches.
     pool_args = (pb_p, y0_np[pos_lane].astype(dt), live, jnp.asarray(frac), transient, tols, nocfg, Wd, mesh, vary,
-                 opaque_true)  # fmt: skip
+                 opaque_true, (int(drain_factor), int(min_drain_width)))  # fmt: skip
     pool_compiled = _background_compiler().submit(_pool_chunk.lower(*pool_args).compile)
     lyap_compiled = None
     if cfg.lyapunov_periods > 0 and not compile_only:
