@@ -113,7 +113,14 @@ def compiled(name: str, fn: Callable, args: tuple, description: str, options: di
 
 @functools.cache
 def _compiler() -> concurrent.futures.ThreadPoolExecutor:
-    return concurrent.futures.ThreadPoolExecutor(max_workers=1, thread_name_prefix="jaxcelt-compile")
+    return concurrent.futures.ThreadPoolExecutor(max_workers=2, thread_name_prefix="jaxcelt-compile")
+
+
+def compile_later(compile_fn: Callable[[], Any]) -> concurrent.futures.Future:
+    """Run ``compile_fn`` (e.g. a lowered program's ``compile``) on one of jaxcelt's compile
+    threads: XLA's CPU compilation of one program uses one core and releases the GIL, so the caller
+    can trace other programs, and two compilations can run at once."""
+    return _compiler().submit(compile_fn)
 
 
 def compile_in_background(name: str, fn: Callable, args: tuple, description: str, options: dict | None = None) -> None:
@@ -135,7 +142,7 @@ def compile_in_background(name: str, fn: Callable, args: tuple, description: str
         _store_for(key, out)
         return out
 
-    _MEMORY[key] = _compiler().submit(finish)
+    _MEMORY[key] = compile_later(finish)
 
 
 def _load(key: str) -> Any:
