@@ -1,7 +1,8 @@
 """The pool's drain: what one pool iteration costs at a given width, and drain schedules A/B.
 
 1. The lanes of the 400 x 300 sweep (omega_pi in [10, 20] from rest, rtol 1e-8) that run to
-   ``max_steps`` when integrated on, run alone (no queue, so no drain) at 3 slots per device and
+   ``max_steps`` when integrated on (with none, as for a small ``--n-freq``, the 6 with the most
+   steps), run alone (no queue, so no drain) at 3 slots per device and
    in pools of 6 and 16 slots per device (padding lanes): seconds per pool iteration.
 2. The whole sweep, stopping at invalid states and integrating on, with the drain halving down to
    16 slots (96, 48, 24) and dividing by 4 down to 4 slots (96, 24, 6): compile apart, run time,
@@ -69,7 +70,10 @@ def main():
             res["schedules"][name]["stop_on_invalid" if stop else "integrate_on"] = r
             print(name, "stop" if stop else "on", r, flush=True)
             if not stop and long is None:
+                # the lanes at max_steps; with none (a small --n-freq), the 6 with the most steps
                 long = np.flatnonzero(out["status"] == 1)
+                if long.size == 0:
+                    long = np.sort(np.argsort(-out["num_steps"], kind="stable")[:6])
 
     # 1. per-iteration cost against the width, on the lanes that run longest
     lv = vals[long]
