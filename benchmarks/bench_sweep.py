@@ -1,7 +1,8 @@
 """Benchmark: one stroboscopic frequency sweep, four ways, side by side.
 
 1. jaxcelt vmapped (`jaxcelt.bifurcation`: the lane pool, exact section times), with Tsit5 (the
-   default) and with Dopri8 (the same 8th-order Dormand-Prince family as scipy's DOP853)
+   default), with Dopri5 (the numba loop's own method: Dormand-Prince 5(4), the same controller)
+   and with Dopri8 (the same 8th-order Dormand-Prince family as scipy's DOP853)
 2. jaxcelt one lane at a time (`jaxcelt.simulate` in a Python loop; subset, extrapolated)
 3. scipy ``solve_ivp(DOP853)`` with the numba RHS, lane by lane: stopping invalid lanes on
    every lane (measured, no extrapolation; ``--scipy-stop-lanes``), integrating on from a subset
@@ -296,6 +297,9 @@ def main():
         ("pool_stop_on_invalid", "pool", True, devs, None),
         ("pool_stop_on_invalid_dopri8", "pool", True, devs, diffrax.Dopri8()),
         ("pool", "pool", False, devs, None),
+        # the numba loop's method: equal work step for step (same tableau and controller)
+        ("pool_stop_on_invalid_dopri5", "pool", True, devs, diffrax.Dopri5()),
+        ("pool_dopri5", "pool", False, devs, diffrax.Dopri5()),
     ]
     if len(devs) > 1:
         runs.insert(1, ("pool_stop_on_invalid_1dev", "pool", True, devs[:1], None))
@@ -352,17 +356,22 @@ def main():
     ra8 = bifurcation(
         p, vals[sub], transient_periods=1, sample_periods=5, rtol=a.rtol, atol=a.atol, solver=diffrax.Dopri8()
     )
+    ra5 = bifurcation(
+        p, vals[sub], transient_periods=1, sample_periods=5, rtol=a.rtol, atol=a.atol, solver=diffrax.Dopri5()
+    )
     ys_a, *_ = nm.dopri_ensemble(Y0a, TSa, PPa, B, Bi, a.rtol, a.atol, 10**7)
     sp_a = np.stack([scipy_lane(Y0a[i], TSa[i], PPa[i], B, Bi, a.rtol, a.atol)[0] for i in range(len(sub))])
     res["accuracy_max_abs_err_5_periods_vs_dop853_1e-12"] = dict(
         jaxcelt=float(np.max(np.abs(ra.samples - ref))),
         jaxcelt_dopri8=float(np.max(np.abs(ra8.samples - ref))),
+        jaxcelt_dopri5=float(np.max(np.abs(ra5.samples - ref))),
         numba_dp5=float(np.max(np.abs(ys_a - ref))),
         scipy_dop853=float(np.max(np.abs(sp_a - ref))),
     )
     print("accuracy", res["accuracy_max_abs_err_5_periods_vs_dop853_1e-12"], flush=True)
     js, jv = res["jaxcelt_pool_stop_on_invalid"], res["jaxcelt_pool"]
     j8 = res["jaxcelt_pool_stop_on_invalid_dopri8"]
+    j5, j5v = res["jaxcelt_pool_stop_on_invalid_dopri5"], res["jaxcelt_pool_dopri5"]
     ns, nv = res["numba_dp5_ensemble_stop_on_invalid"], res["numba_dp5_ensemble"]
     ss, sv = res["scipy_dop853_numba_rhs_stop_on_invalid"], res["scipy_dop853_numba_rhs"]
     res["summary"] = dict(
@@ -383,6 +392,9 @@ def main():
         speedup_vs_jaxcelt_lane_by_lane=res["jaxcelt_lane_by_lane"]["seconds"] / js["seconds"],
         wall_ratio_vs_numba_ensemble_stop=js["seconds"] / ns["seconds"],
         wall_ratio_vs_numba_ensemble_integrate_on=jv["seconds"] / nv["seconds"],
+        # the same method as the numba loop (Dopri5): equal work step for step
+        wall_ratio_dopri5_vs_numba_ensemble_stop=j5["seconds"] / ns["seconds"],
+        wall_ratio_dopri5_vs_numba_ensemble_integrate_on=j5v["seconds"] / nv["seconds"],
         core_us_per_rhs_jaxcelt=js["core_us_per_rhs"],
         core_us_per_rhs_numba=ns["us_per_rhs_cpu"],
         per_rhs_ratio_jaxcelt_vs_numba=js["core_us_per_rhs"] / ns["us_per_rhs_cpu"],
@@ -399,6 +411,7 @@ def main():
 
     rows = [
         (f"jaxcelt pool\n{len(devs)} dev", js["seconds"], jv["seconds"], "tab:blue"),
+        (f"jaxcelt pool\nDopri5, {len(devs)} dev", j5["seconds"], j5v["seconds"], "tab:brown"),
         (f"jaxcelt pool\nDopri8, {len(devs)} dev", j8["seconds"], None, "tab:olive"),
     ]
     if "jaxcelt_pool_stop_on_invalid_1dev" in res:

@@ -101,6 +101,28 @@ QUOTES = [
     # the side-by-side sweep benchmark (benchmarks/bench_sweep.py)
     ("docs/bifurcation/README.md", lambda: f"**{_bench()['summary']['jaxcelt_stop_on_invalid_s']:.2f}**"),
     ("docs/bifurcation/README.md", lambda: f"**{_bench()['summary']['jaxcelt_dopri8_stop_on_invalid_s']:.2f}**"),
+    # the numba loop's own method (Dopri5): equal work step for step
+    ("docs/bifurcation/README.md", lambda: f"**{_bench()['jaxcelt_pool_stop_on_invalid_dopri5']['seconds']:.2f}**"),
+    (
+        "docs/bifurcation/README.md",
+        lambda: (
+            f"{_bench()['jaxcelt_pool_dopri5']['seconds']:.1f} (+ {_bench()['jaxcelt_pool_dopri5']['compile_seconds']:.1f} compile)"
+        ),
+    ),
+    (
+        "docs/bifurcation/README.md",
+        lambda: f"{1 / _bench()['summary']['wall_ratio_dopri5_vs_numba_ensemble_stop']:.2f}× faster stopping",
+    ),
+    (
+        "docs/bifurcation/README.md",
+        lambda: f"{_bench()['summary']['wall_ratio_dopri5_vs_numba_ensemble_integrate_on']:.2f}× slower integrating on, where",
+    ),
+    (
+        "docs/performance.md",
+        lambda: "jaxcelt takes {:.2f} s and {:.1f} s".format(
+            _bench()["jaxcelt_pool_stop_on_invalid_dopri5"]["seconds"], _bench()["jaxcelt_pool_dopri5"]["seconds"]
+        ),
+    ),
     (
         "docs/bifurcation/README.md",
         lambda: (
