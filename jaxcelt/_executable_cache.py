@@ -98,8 +98,7 @@ def compiled(name: str, fn: Callable, args: tuple, description: str, options: di
     if exe is None:
         exe = _load(key)
         if exe is None:
-            exe = jax.jit(fn).lower(*args).compile(options)
-            _store_for(key, exe)
+            exe = _compile_and_store(key, jax.jit(fn).lower(*args), options)
         _MEMORY[key] = exe
     if isinstance(exe, concurrent.futures.Future):
         try:
@@ -136,13 +135,14 @@ def compile_in_background(name: str, fn: Callable, args: tuple, description: str
         _MEMORY[key] = exe
         return
     lowered = jax.jit(fn).lower(*args)
+    _MEMORY[key] = compile_later(functools.partial(_compile_and_store, key, lowered, options))
 
-    def finish():
-        out = lowered.compile(options)
-        _store_for(key, out)
-        return out
 
-    _MEMORY[key] = compile_later(finish)
+def _compile_and_store(key: str, lowered: Any, options: dict | None) -> Any:
+    """XLA-compile ``lowered`` with ``options`` and store the executable under ``key`` (if a directory is set)."""
+    exe = lowered.compile(options)
+    _store_for(key, exe)
+    return exe
 
 
 def _load(key: str) -> Any:
