@@ -2,11 +2,14 @@
 
 1. The lanes of the 400 x 300 sweep (omega_pi in [10, 20] from rest, rtol 1e-8) that run to
    ``max_steps`` when integrated on (with none, as for a small ``--n-freq``, the 6 with the most
-   steps), run alone (no queue, so no drain) at 3 slots per device and
-   in pools of 6 and 16 slots per device (padding lanes): seconds per pool iteration.
-2. The whole sweep, stopping at invalid states and integrating on, with the drain halving down to
-   16 slots (96, 48, 24) and dividing by 4 down to 4 slots (96, 24, 6): compile apart, run time,
-   iterations, step slots paid.
+   steps), run alone (no queue, so no drain) at 3 slots per device and in pools of 4, 6 and 16
+   slots per device (padding lanes): seconds per pool iteration. Pools of at most
+   `jaxcelt.ensemble.pool.SEQUENTIAL_WIDTH` slots step in the inner loop whose kernels XLA runs
+   one after the other.
+2. The whole sweep, stopping at invalid states and integrating on, with the drain dividing the
+   width by 4 down to 6 slots (96, 24, 6: every width steps once per iteration) and down to 4 slots
+   (96, 24, 4: the library's default; the last width steps in the inner loop): compile apart, run
+   time, iterations, step slots paid.
 
     .venv/bin/python benchmarks/bench_drain.py --out docs/bifurcation
 """
@@ -58,7 +61,7 @@ def main():
             slot_steps=st.slot_steps, steps=int(out["num_steps"].sum()), status_counts=status,
         )  # fmt: skip
 
-    schedules = {"halve_to_16": (16, 2), "quarter_to_4": (4, 4)}
+    schedules = {"quarter_to_6": (6, 4), "quarter_to_4": (4, 4)}
     res["schedules"] = {}
     long = None
     for name, (md, fac) in schedules.items():
@@ -80,7 +83,7 @@ def main():
     cfg = SweepConfig(transient_periods=200, sample_periods=100, stop_on_invalid=False, max_steps=a.tail_max_steps)
     ndev = len(jax.devices())
     res["lone_lanes"] = dict(omega_pi=lv.tolist(), max_steps=a.tail_max_steps, widths={})
-    for pad in (None, 6 * ndev, 16 * ndev):
+    for pad in (None, 4 * ndev, 6 * ndev, 16 * ndev):
         _, r = run(lv, cfg, pad_to=pad)
         w = -(-max(len(lv), pad or 0) // ndev)
         r["us_per_iteration"] = 1e6 * r["run_s"] / r["iterations"]

@@ -228,9 +228,9 @@ def test_pool_other_solvers_equal_simulate(paper_params, solver):
 
 
 def test_pool_drain_compaction_keeps_lanes(paper_params):
-    # 40 lanes through 32 slots: once <= 8 lanes are left the pool continues 8 wide
-    # (`_pool`'s drain). Lanes must not depend on the width they ran at: compare with a
-    # pool that is 8 wide from the start. Different widths are different compiled programs
+    # 40 lanes through 32 slots: once <= 4 lanes are left the pool continues 4 wide, stepping in
+    # its inner loop (`run_pool`'s drain). Lanes must not depend on the width they ran at: compare
+    # with a pool that is 8 wide from the start. Different widths are different compiled programs
     # (on an AVX-512 CPU ~half the samples differ at <= 1.6e-12 relative), so: same step
     # counts and statuses, samples within SAMPLE_ATOL (see _sweep_common).
     from jaxcelt.sweep import SweepConfig, run_lanes
@@ -246,6 +246,43 @@ def test_pool_drain_compaction_keeps_lanes(paper_params):
     assert paid < 32 * it  # the drain ran narrower
     assert paid >= int(wide["num_steps"].sum())
     assert_same_lanes(wide, narrow)
+
+
+def test_narrow_pool_inner_loop_keeps_lanes(paper_params):
+    # A pool of at most SEQUENTIAL_WIDTH slots steps in an inner loop until a lane reaches a
+    # section time, finishes or pauses, and its stepper sees only each lane's next two section
+    # times (`run_pool`). 12 lanes through 3 slots (a queue, pilot pauses, refills, lanes that stop
+    # invalid and lanes that run out of steps) must equal the same lanes through 12 slots stepped
+    # once per iteration. Another width is another compiled program: same steps and statuses,
+    # floats within SAMPLE_ATOL (min_N to rtol 1e-7, as in the pilot test below).
+    from jaxcelt.ensemble.pool import SEQUENTIAL_WIDTH
+    from jaxcelt.sweep import SweepConfig, run_lanes
+
+    # from rest, omega_pi = 10 and 10.5 need > 3000 steps to their first invalid state (~4.9
+    # periods), 11.5 and 12.25 ~2100-2300 (~5.5-6 periods); 14-19 stay valid over 7 periods.
+    # (Near 13.9 a lane amplifies rounding to ~1.6e-10 over these 7 periods between any two pool
+    # widths, with or without the inner loop: a lane the 1e-10 tolerance does not cover.)
+    vals = np.concatenate([[10.0, 10.5, 11.5, 12.25], np.linspace(14.0, 19.0, 8)])
+    y0 = np.tile(np.asarray(jc.initial_state(paper_params)), (len(vals), 1))
+    pb = lanes_params(paper_params, "omega_pi", vals)
+    cfg = SweepConfig(transient_periods=1, sample_periods=6, max_steps=2800, stop_on_invalid=True)
+    one = jax.local_devices()[:1]
+    narrow = run_lanes(pb, y0, cfg, width=3, devices=one)
+    wide = run_lanes(pb, y0, cfg, width=len(vals), devices=one)
+    assert 3 <= SEQUENTIAL_WIDTH < len(vals)
+    assert set(np.unique(wide["status"])) >= {0, 1, 2}  # finished, out of steps, stopped invalid
+    # one width, every slot paid at every step; the inner loop's steps are counted as iterations
+    it, paid = int(narrow["pool_iterations"][0]), int(narrow["pool_slot_steps"][0])
+    assert paid == 3 * it and paid >= int(narrow["num_steps"].sum())
+    assert_same_lanes(narrow, wide, keys=("samples", "num_steps", "status"))
+    # max tilt = arccos(min n3) amplifies an n3 difference by 1/sin(tilt) (~20 at 0.05 rad): rtol 1e-7
+    np.testing.assert_allclose(narrow["max_tilt"], wide["max_tilt"], rtol=1e-7)
+    # final states of the lanes that ran to the end; the others end tumbling towards lift-off,
+    # where two widths' rounding grows to ~1e-7 in 5 periods (with or without the inner loop)
+    ok = wide["status"] == 0
+    np.testing.assert_allclose(narrow["y_final"][ok], wide["y_final"][ok], rtol=0, atol=SAMPLE_ATOL)
+    np.testing.assert_allclose(narrow["first_invalid_t"], wide["first_invalid_t"], rtol=1e-9)
+    np.testing.assert_allclose(narrow["min_N"], wide["min_N"], rtol=1e-7)
 
 
 def test_pool_pilot_pause_keeps_lanes(paper_params):

@@ -14,8 +14,14 @@ Scheduling:
   them costliest first (longest-processing-time order), so the drain runs on short lanes. A
   pause does not change a lane: it resumes with the same state and step sequence.
 * The drain: once no more than a quarter of the slots have work left, the running lanes move to
-  a pool a quarter as wide (widths B, B/4, ... down to `MIN_DRAIN_WIDTH`; `DRAIN_FACTOR`). Each width compiles the
-  step again, so only pools with a queue (more lanes than slots) do this.
+  a pool a quarter as wide (`DRAIN_FACTOR`), and at the end to one of `MIN_DRAIN_WIDTH` slots
+  (96, 24, 4). Each width compiles the step again, so only pools with a queue (more lanes than
+  slots) do this.
+* A pool of at most `SEQUENTIAL_WIDTH` slots (the drain's last width, or a chunk of a few lanes
+  per device) steps in an inner loop until one of its lanes reaches a section time, finishes or
+  pauses; that loop touches only small buffers, so XLA's CPU runtime runs its kernels one after the
+  other on the calling thread instead of handing them to its thread pool. The lanes that run
+  longest spend most of their steps there.
 
 Only the lane-varying parameters ride in the slots (`split_lane_args`); the others enter the
 step as unbatched constants. How the loop went (iterations, step slots paid) comes back as
@@ -44,6 +50,7 @@ __all__ = [
     "DEFAULT_WIDTH",
     "MIN_DRAIN_WIDTH",
     "DRAIN_FACTOR",
+    "SEQUENTIAL_WIDTH",
     "PILOT_FRACTION",
 ]
 
@@ -53,14 +60,17 @@ launches on CPU) besides its per-slot work, so wider pools finish in fewer itera
 the fastest width for 400 lanes x 300 periods on 2 cores with the pilot pause
 (``benchmarks/bench_schedule.py``; docs/bifurcation/README.md)."""
 MIN_DRAIN_WIDTH = 4
-"""narrowest pool of the drain"""
+"""the drain's last width (at most `SEQUENTIAL_WIDTH`: it steps in the inner loop)"""
 DRAIN_FACTOR = 4
-"""each width of the drain is the previous one divided by this: 96, 24, 6 slots. An iteration
-costs about 10 us plus 1.1 us per slot on a 2-core CPU (the lanes that run longest, alone:
-12.8 us at 3 slots, 26.9 us at 16), so the last few long lanes should run in a narrow pool; with
-a factor of 4 that takes no more compiled widths than halving down to 24 did (400 lanes x 300
-periods integrated on: 30.4 s instead of 40.3 s; ``benchmarks/bench_drain.py`` ->
-docs/bifurcation/drain.json)"""
+"""the drain divides the width by this while the result stays at least this times
+`MIN_DRAIN_WIDTH`, then ends at `MIN_DRAIN_WIDTH`: 96, 24, 4 slots. The last few lanes, which
+run longest when lanes are integrated on, belong in a narrow pool (``benchmarks/bench_drain.py``
+-> docs/bifurcation/drain.json)"""
+SEQUENTIAL_WIDTH = 4
+"""widest pool that steps in the inner loop (`run_pool`). XLA's CPU runtime runs a sequence of
+kernels one after the other on the calling thread when every buffer they touch holds at most
+512 bytes; otherwise it hands ready kernels to its thread pool, which costs microseconds per pool
+iteration when the kernels are small. 4 lanes x 13 float64 = 416 bytes."""
 PILOT_FRACTION = 0.1
 """a lane pauses once after this fraction of its time span and waits for a slot with its
 predicted remaining cost (``benchmarks/bench_schedule.py``)"""
@@ -179,8 +189,11 @@ def run_pool(
     ``lanes``, ``samples``: from `start_lanes` (``samples`` (L, S, n) is written in place);
     ``lane_args``/``args_of``: `split_lane_args`; ``ts_all`` (L, S): section times. A lane
     pauses at the end of its first step past t0 + ``pause_frac`` (t1 - t0) (inf: never); it
-    stops between two steps, so resuming it continues the very same step sequence. Call inside
-    jit. Returns (final lanes, samples, `PoolStats`)."""
+    stops between two steps, so resuming it continues the very same step sequence. A pool of at
+    most `SEQUENTIAL_WIDTH` slots whose stepper reads only the next two section times
+    (``stepper.section_window``) steps in an inner loop until a lane reaches a section time,
+    finishes or pauses: the same steps, fewer kernel launches per step. Call inside jit. Returns
+    (final lanes, samples, `PoolStats`)."""
     L = samples.shape[0]
     B = min(width, L)
     # the queue: lanes with work (not padding, not invalid at t0 with stop_on_invalid), in order
@@ -205,11 +218,48 @@ def run_pool(
 
     no = jnp.asarray(-jnp.inf)
 
+    def one_step(slots: _Slots, active: Array):
+        stepped, hit, paused = step_v(slots)
+        return _where_rows(active, stepped, slots), hit, paused, jnp.ones((), jnp.int32)
+
+    def steps_to_event(slots: _Slots, active: Array):
+        # Steps every slot until one of the active lanes reaches its next section time, finishes
+        # or pauses. The inner loop sees only the slots and each lane's next two section times
+        # (the window; inf past the last, lane.k counted from 0 in it), so on a narrow pool every
+        # buffer it touches is small (`SEQUENTIAL_WIDTH`). The window is exact until the next
+        # section time is reached, and the loop ends there.
+        S = ts_all.shape[1]
+        k0 = slots.lane.k
+        inf = jnp.asarray(jnp.inf, ts_all.dtype)
+        window = jnp.stack(
+            [
+                jnp.where(k0 + i < S, jnp.take_along_axis(slots.ts, jnp.minimum(k0 + i, S - 1)[:, None], 1)[:, 0], inf)
+                for i in (0, 1)
+            ],
+            axis=-1,
+        )
+        inner = slots._replace(lane=eqx.tree_at(lambda s: s.k, slots.lane, jnp.zeros_like(k0)), ts=window)
+        none = jnp.zeros_like(active)
+
+        def icond(ic):
+            return ~ic[3]
+
+        def ibody(ic):
+            sl, _, _, _, n = ic
+            sl, hit, paused, _ = one_step(sl, active)
+            event = jnp.any(active & (hit | sl.lane.done | paused))
+            return sl, hit, paused, event, n + 1
+
+        z = jnp.zeros((), jnp.int32)
+        inner, hit, paused, _, n = jax.lax.while_loop(icond, ibody, (inner, none, none, ~jnp.any(active), z))
+        lane = eqx.tree_at(lambda s: s.k, inner.lane, k0 + inner.lane.k)
+        return slots._replace(lane=lane, resumed=inner.resumed, args=inner.args), hit, paused, n
+
     def body(c: _Carry) -> _Carry:
         slots, lane = c.slots, c.lane
         active = (lane < L) & ~slots.lane.done
-        stepped, hit, paused = step_v(slots)
-        slots = _where_rows(active, stepped, slots)
+        narrow = lane.shape[0] <= SEQUENTIAL_WIDTH and stepper.section_window
+        slots, hit, paused, n_steps = (steps_to_event if narrow else one_step)(slots, active)
         w = jnp.where(active & hit, lane, L)
         samples = c.samples.at[w, slots.lane.k - 1].set(slots.lane.y, mode="drop")
         pause = active & paused
@@ -244,12 +294,16 @@ def run_pool(
         slots, lane, nxt, wait, lanes, resumed = jax.lax.cond(
             jnp.any(fin), swap, lambda a: a, (slots, lane, c.nxt, c.wait, c.lanes, c.resumed)
         )
-        return _Carry(slots, lane, nxt, wait, lanes, resumed, samples, c.iters + 1, c.slot_steps + lane.shape[0])
+        iters, paid = c.iters + n_steps, c.slot_steps + n_steps * lane.shape[0]
+        return _Carry(slots, lane, nxt, wait, lanes, resumed, samples, iters, paid)
 
-    # the drain: widths B, B/4, B/16, ... (see the module docstring)
+    # the drain: widths B, B/4, ..., MIN_DRAIN_WIDTH (see the module docstring and DRAIN_FACTOR)
     widths = [B]
-    while L > B and widths[-1] // drain_factor >= min_drain_width:
-        widths.append(widths[-1] // drain_factor)
+    if L > B:
+        while widths[-1] // drain_factor >= drain_factor * min_drain_width:
+            widths.append(widths[-1] // drain_factor)
+        if widths[-1] > min_drain_width:
+            widths.append(min_drain_width)
     z = jnp.zeros((), jnp.int32)
     resumed = jnp.zeros_like(lanes.done)
     lane = lane_at(jnp.arange(B, dtype=jnp.int32))

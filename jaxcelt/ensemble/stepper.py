@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import abc
 from collections.abc import Callable
-from typing import Any
+from typing import Any, ClassVar
 
 import diffrax
 import equinox as eqx
@@ -110,6 +110,10 @@ def _start(
 
 class AbstractLaneStepper(eqx.Module):
     """Steps one lane; `jax.vmap` it over a batch of lanes (the pool does)."""
+
+    section_window: ClassVar[bool] = False
+    """whether ``step`` reads only ``ts[lane.k]`` and ``ts[lane.k + 1]`` (so that the pool may
+    pass a window of the next two section times, inf past the last)"""
 
     @abc.abstractmethod
     def init(self, t0: Array, y0: Array, ts: Array, p: CeltParams, tols: Array) -> LaneState:
@@ -222,6 +226,8 @@ class FusedERKStepper(AbstractLaneStepper):
     boundaries). Only the equality tests against `simulate` would notice if diffrax's PID
     controller changed its algorithm.
     """
+
+    section_window: ClassVar[bool] = True
 
     solver: MonitoredSolver
     """only for the first step size (diffeqsolve's choice, as `DiffraxStepper`)"""
