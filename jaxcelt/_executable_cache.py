@@ -117,16 +117,16 @@ def _compiler() -> concurrent.futures.ThreadPoolExecutor:
 
 def compile_later(compile_fn: Callable[[], Any]) -> concurrent.futures.Future:
     """Run ``compile_fn`` (e.g. a lowered program's ``compile``) on one of jaxcelt's compile
-    threads: XLA's CPU compilation of one program uses one core and releases the GIL, so the caller
-    can trace other programs, and two compilations can run at once."""
+    threads: XLA's compilation releases the GIL, so the caller can trace other programs, and two
+    compilations can run at once."""
     return _compiler().submit(compile_fn)
 
 
 def compile_in_background(name: str, fn: Callable, args: tuple, description: str, options: dict | None = None) -> None:
     """Start making the program `compiled` would return: traced and lowered now (in the calling
     thread: tracing is Python), compiled by XLA on a worker thread, so that the caller can trace and
-    compile its other programs meanwhile (XLA's CPU compilation of one program uses one core and
-    releases the GIL). A program already in memory or on disk is loaded now instead."""
+    compile its other programs meanwhile (XLA's compilation releases the GIL). A program already in
+    memory or on disk is loaded now instead."""
     key = _key(name, description, args, options)
     if key in _MEMORY:
         return

@@ -92,7 +92,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from . import _config  # noqa: F401
-from .contact import AbstractContactLaw
+from ._compile_options import compiler_options
+from .contact import AbstractContactLaw, get_contact_law
 from .diagnostics import centre_position
 from .ensemble import DEFAULT_WIDTH as DEFAULT_WIDTH
 from .ensemble import MIN_DRAIN_WIDTH as MIN_DRAIN_WIDTH
@@ -101,7 +102,7 @@ from .ensemble.stroboscopic import SweepConfig, lanes_params, run_lanes, run_lan
 from .ensemble.stroboscopic import _erk_tableau as _erk_tableau  # noqa: F401  (tests)
 from .params import PARAM_NAMES, CeltParams
 from .solve import DEFAULT_SOLVER, simulate
-from .state import initial_state
+from .state import check_state, initial_state
 
 __all__ = [
     "SweepConfig",
@@ -724,7 +725,20 @@ def continuation(
     return out
 
 
-_centre_positions = jax.jit(jax.vmap(centre_position, in_axes=(0, None)))
+def _orbit_impl(params, y0, ts, rtol, atol, *, solver, law, max_steps):
+    sol = simulate(
+        params, y0, ts[-1], ts=ts, solver=solver, rtol=rtol, atol=atol, max_steps=max_steps, contact_law=law,
+        exact_ts=True,
+    )  # fmt: skip
+    r_O = jax.vmap(centre_position, in_axes=(0, None))(sol.ys, params)
+    return sol.ys, r_O, sol.status, sol.valid
+
+
+# `orbit`'s program (the solve and the centre positions), per platform: on a CPU compiled with
+# XLA's loop emitters, as the sweep's Lyapunov stage (`jaxcelt._compile_options`)
+_orbit_program = {
+    platform: eqx.filter_jit(_orbit_impl, compiler_options=compiler_options(platform)) for platform in ("cpu", "other")
+}
 
 
 def orbit(
@@ -754,17 +768,25 @@ def orbit(
     T = 2 * np.pi / w
     k = np.arange(periods * points_per_period + 1)
     ts = T * (transient_periods + k / points_per_period)
-    sol = simulate(
-        params, y0, ts[-1], ts=ts, solver=solver, rtol=rtol, atol=atol, max_steps=max_steps,
-        contact_law=contact_law, exact_ts=True,
+    check_state(y0, params, name="y0")
+    y0 = np.asarray(y0, dtype=np.float64)
+    if y0.shape != (13,):
+        raise ValueError(f"'y0' must have shape (13,), got {y0.shape}")
+    for name, tol in (("rtol", rtol), ("atol", atol)):
+        if not (np.ndim(tol) == 0 and np.isfinite(tol) and tol > 0):
+            raise ValueError(f"{name!r} must be a positive finite number, got {tol!r}")
+    if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1:
+        raise ValueError(f"max_steps must be a positive int, got {max_steps!r}")
+    program = _orbit_program["cpu" if jax.default_backend() == "cpu" else "other"]
+    ys, r_O, status, valid = program(
+        params, y0, ts, jnp.asarray(rtol, jnp.float64), jnp.asarray(atol, jnp.float64),
+        solver=solver or DEFAULT_SOLVER, law=get_contact_law(contact_law), max_steps=max_steps,
     )  # fmt: skip
-    ys = np.asarray(sol.ys)
-    r_O = np.asarray(_centre_positions(sol.ys, params))
     return dict(
         ts=ts,
-        ys=ys,
-        r_O=r_O,
+        ys=np.asarray(ys),
+        r_O=np.asarray(r_O),
         section_index=np.arange(0, len(ts), points_per_period),
-        status=int(sol.status),
-        valid=bool(sol.valid),
+        status=int(status),
+        valid=bool(valid),
     )

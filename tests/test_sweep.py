@@ -544,3 +544,25 @@ def test_sweep_lanes_any_batch_equals_bifurcation(base, paper_params, tmp_path):
         sweep_lanes(paper_params, {"omega_pi": om, "q_pi": q[:2]}, **KW)
     with pytest.raises(ValueError, match="mu"):
         sweep_lanes(paper_params, {"mu": [0.2, -0.1]}, **KW)
+
+
+def test_orbit_equals_simulate(paper_params):
+    # `orbit` (the phase plots' trajectories) is `simulate` stepping onto the save times, compiled
+    # as its own program with XLA's loop emitters: the same steps, so states equal to rounding
+    # (SAMPLE_ATOL, see _sweep_common), and the centre O of `centre_position` at every state.
+    from jaxcelt.diagnostics import centre_position
+    from jaxcelt.sweep import orbit
+
+    p = paper_params.replace(omega_pi=17.0)
+    o = orbit(p, transient_periods=2, periods=3, points_per_period=8)
+    sol = jc.simulate(p, jc.initial_state(p), o["ts"][-1], ts=o["ts"], exact_ts=True)
+    assert o["status"] == int(sol.status) == 0 and o["valid"]
+    np.testing.assert_allclose(o["ys"], np.asarray(sol.ys), rtol=0, atol=SAMPLE_ATOL)
+    r_O = np.stack([np.asarray(centre_position(y, p)) for y in np.asarray(sol.ys)])
+    np.testing.assert_allclose(o["r_O"], r_O, rtol=0, atol=1e-12)  # metres; states agree to ~1e-13
+    T = 2 * np.pi / 17.0
+    np.testing.assert_allclose(o["ts"][o["section_index"]], T * (2 + np.arange(4)), rtol=1e-14)
+    with pytest.raises(ValueError, match="rtol"):
+        orbit(p, transient_periods=1, periods=1, rtol=-1.0)
+    with pytest.raises(ValueError, match="y0"):
+        orbit(p, np.zeros(13), transient_periods=1, periods=1)

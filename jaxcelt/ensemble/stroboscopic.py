@@ -263,7 +263,7 @@ def run_lanes_with_stats(
     G = Wd * ndev  # the Lyapunov stage's chunk: the pool's width (a chunk of few lanes solves no padding copies)
     lyap_fn = _lyap_chunk["cpu" if platform == "cpu" else "other"]
     # The pool's program and the Lyapunov stage's are traced here, one after the other, and
-    # compiled by XLA on worker threads at the same time (one XLA compilation uses one core); both
+    # compiled by XLA on worker threads at the same time (XLA releases the GIL while compiling); both
     # are then called as compiled programs. Later chunks of the same shapes find them in JAX's caches.
     pool_args = (pb_p, y0_np[pos_lane].astype(dt), live, jnp.asarray(frac), transient, tols, nocfg, Wd, mesh, vary,
                  opaque_true, (int(drain_factor), int(min_drain_width)))  # fmt: skip
