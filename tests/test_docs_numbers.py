@@ -103,6 +103,14 @@ QUOTES = [
         "docs/bifurcation/README.md",
         lambda: f"{_json('docs/bifurcation/summary_400x300.json')['lanes_invalid']} of the 400 lanes",
     ),
+    # the 100 x 60 parameter map (scripts/map_study.py)
+    (
+        "docs/map/README.md",
+        lambda: (
+            f"**Time: {_json('docs/map/map_omega_q_100x60.json')['wall_seconds_including_compile']:.0f} s including "
+            f"compilation ({_json('docs/map/map_omega_q_100x60.json')['whole_command_seconds']:.0f} s for the whole command)**"
+        ),
+    ),
     # the side-by-side sweep benchmark (benchmarks/bench_sweep.py)
     ("docs/bifurcation/README.md", lambda: f"**{_bench()['summary']['jaxcelt_stop_on_invalid_s']:.2f}**"),
     ("docs/bifurcation/README.md", lambda: f"**{_bench()['summary']['jaxcelt_dopri8_stop_on_invalid_s']:.2f}**"),
