@@ -60,7 +60,7 @@ launches on CPU) besides its per-slot work, so wider pools finish in fewer itera
 the fastest width for 400 lanes x 300 periods on 2 cores with the pilot pause
 (``benchmarks/bench_schedule.py``; docs/bifurcation/README.md)."""
 MIN_DRAIN_WIDTH = 4
-"""the drain's last width (at most `SEQUENTIAL_WIDTH`: it steps in the inner loop)"""
+"""the drain's last width (by default `SEQUENTIAL_WIDTH`, so that it steps in the inner loop)"""
 DRAIN_FACTOR = 4
 """the drain divides the width by this while the result stays at least this times
 `MIN_DRAIN_WIDTH`, then ends at `MIN_DRAIN_WIDTH`: 96, 24, 4 slots. The last few lanes, which
@@ -192,8 +192,8 @@ def run_pool(
     stops between two steps, so resuming it continues the very same step sequence. A pool of at
     most `SEQUENTIAL_WIDTH` slots whose stepper reads only the next two section times
     (``stepper.section_window``) steps in an inner loop until a lane reaches a section time,
-    finishes or pauses: the same steps, fewer kernel launches per step. Call inside jit. Returns
-    (final lanes, samples, `PoolStats`)."""
+    finishes or pauses: the same steps, whose kernels XLA's CPU runtime then runs without its thread
+    pool. Call inside jit. Returns (final lanes, samples, `PoolStats`)."""
     L = samples.shape[0]
     B = min(width, L)
     # the queue: lanes with work (not padding, not invalid at t0 with stop_on_invalid), in order
