@@ -5,8 +5,10 @@ twice in one fresh process with JAX's persistent cache off (``JAXCELT_CACHE_DIR=
 run compiles every program, the second finds them compiled in the process. The difference of
 the two is what compilation adds to the run (tracing and XLA compilation on the critical path,
 less whatever overlaps with other work). Reported for the sweep (``wall_seconds_including_compile``
-of each run's summary.json) and for the whole command; matplotlib is imported before the first
-run, so that its import is not counted. Also the tracing and XLA compilation times JAX logs
+of each run's summary.json) and for the whole command. The modules the command imports
+(`PRE_IMPORTED`: matplotlib, xarray, h5py, ...) and JAX's CPU backend are loaded before the first
+run, so that only compilation is counted; their times are reported apart (``imports_s``,
+``backend_start_s``). Also the tracing and XLA compilation times JAX logs
 (``jax_log_compiles``) for the programs that take more than 0.2 s.
 
     .venv/bin/python benchmarks/main_job_compile.py [--reps 3] [--out docs/bifurcation/main_job_compile.json]
@@ -27,6 +29,19 @@ import tempfile
 import time
 from pathlib import Path
 
+PRE_IMPORTED = (
+    "matplotlib.pyplot",
+    "xarray",
+    "h5py",
+    "h5netcdf",
+    "tqdm.auto",
+    "PIL.Image",
+    "jaxcelt.cli",
+    "jaxcelt.dataset",
+    "jaxcelt.sweep",
+    "jaxcelt.plotting.bifurcation",
+)
+
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -36,8 +51,20 @@ def main(argv=None) -> int:
     if a.reps > 1:
         return _repeated(a.out, a.reps)
     os.environ["JAXCELT_CACHE_DIR"] = "off"
+    import importlib
+
+    t = time.perf_counter()
+    # the modules the command imports on its first run (not counted; their time is reported apart)
+    for mod in PRE_IMPORTED:
+        importlib.import_module(mod)
+    imports_s = time.perf_counter() - t
     import jax
-    import matplotlib.pyplot  # noqa: F401  (imported before the first run: not counted)
+
+    # JAX's CPU backend with the command's device count ("auto"), started before the first run
+    t = time.perf_counter()
+    jax.config.update("jax_num_cpu_devices", os.cpu_count() or 1)
+    jax.devices()
+    backend_start_s = time.perf_counter() - t
 
     from jaxcelt.cli import main as cli
     from jaxcelt.versions import versions
@@ -57,7 +84,14 @@ def main(argv=None) -> int:
         lg.setLevel(logging.DEBUG)
         lg.propagate = False
     # versions() after the runs: it starts JAX's backend, and the command sets the CPU device count first
-    res: dict = dict(cpu_count=os.cpu_count(), load_average_at_start=os.getloadavg(), runs=[])
+    res: dict = dict(
+        cpu_count=os.cpu_count(),
+        load_average_at_start=os.getloadavg(),
+        pre_imported=list(PRE_IMPORTED),
+        imports_s=imports_s,
+        backend_start_s=backend_start_s,
+        runs=[],
+    )
     with tempfile.TemporaryDirectory() as tmp:
         for i in range(2):
             out = Path(tmp) / f"run{i}"
@@ -111,6 +145,8 @@ def _repeated(out: Path, reps: int) -> int:
     )
     res["sweep_compile_overhead_s_median"] = statistics.median(res["sweep_compile_overhead_s_each"])
     res["command_compile_overhead_s_median"] = statistics.median(res["command_compile_overhead_s_each"])
+    res["imports_s_median"] = statistics.median(r["imports_s"] for r in each)
+    res["backend_start_s_median"] = statistics.median(r["backend_start_s"] for r in each)
     res["versions"] = each[0]["versions"]
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(res, indent=1))

@@ -19,6 +19,7 @@ from typing import Any
 
 import diffrax
 import equinox.internal as eqxi
+import jax
 import jax.numpy as jnp
 from diffrax._root_finder import use_stepsize_tol  # not re-exported at top level
 from diffrax._term import WrapTerm  # what diffeqsolve wraps terms in (not re-exported)
@@ -73,10 +74,9 @@ def wrap_term(term: diffrax.AbstractTerm) -> diffrax.AbstractTerm:
 
 def t1_clip_floor(t1: Array) -> Array:
     """t1 - 100 ULP: diffeqsolve rounds a proposed step end above this onto t1."""
-    floor = t1
-    for _ in range(100):
-        floor = eqxi.prevbefore(floor)
-    return floor
+    # diffeqsolve unrolls these 100 steps (~1 500 HLO operations, one large kernel to compile);
+    # a loop gives the same value for a fraction of the compilation
+    return jax.lax.fori_loop(0, 100, lambda _, f: eqxi.prevbefore(f), t1)
 
 
 def clip_to_end(tprev: Array, tnext: Array, t1: Array, floor: Array, keep: Array) -> tuple[Array, Array]:

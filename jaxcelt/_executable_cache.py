@@ -20,14 +20,16 @@ executable runs code from the file: the directory must be the user's own, as JAX
 from __future__ import annotations
 
 import concurrent.futures
+import contextlib
 import functools
+import gc
 import hashlib
 import os
 import pickle
 import platform
 import tempfile
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -35,6 +37,23 @@ import jax
 
 _MEMORY: dict[str, Any] = {}  # key -> executable, or a Future of one being compiled in the background
 SUBDIR = "jaxcelt-executables"
+
+
+@contextlib.contextmanager
+def gc_paused() -> Iterator[None]:
+    """Python's cyclic garbage collector off while the block runs (then back as it was).
+
+    Tracing a program that holds an ODE solve allocates millions of objects that live until the
+    trace ends, and every full collection during the trace walks all of them: without collections
+    the sweep's pool, its Lyapunov stage and `jaxcelt.sweep.orbit` trace in about 0.7 of the time
+    (``benchmarks/main_job_compile.py``). The block's cycles are collected later, as usual."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
 
 
 @functools.cache
@@ -98,7 +117,9 @@ def compiled(name: str, fn: Callable, args: tuple, description: str, options: di
     if exe is None:
         exe = _load(key)
         if exe is None:
-            exe = _compile_and_store(key, jax.jit(fn).lower(*args), options)
+            with gc_paused():
+                lowered = jax.jit(fn).lower(*args)
+            exe = _compile_and_store(key, lowered, options)
         _MEMORY[key] = exe
     if isinstance(exe, concurrent.futures.Future):
         try:
@@ -134,7 +155,8 @@ def compile_in_background(name: str, fn: Callable, args: tuple, description: str
     if exe is not None:
         _MEMORY[key] = exe
         return
-    lowered = jax.jit(fn).lower(*args)
+    with gc_paused():
+        lowered = jax.jit(fn).lower(*args)
     _MEMORY[key] = compile_later(functools.partial(_compile_and_store, key, lowered, options))
 
 

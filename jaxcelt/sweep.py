@@ -93,6 +93,7 @@ import numpy as np
 
 from . import _config  # noqa: F401
 from ._compile_options import compiler_options
+from ._executable_cache import compile_in_background, compiled
 from .contact import AbstractContactLaw, get_contact_law
 from .diagnostics import centre_position
 from .ensemble import DEFAULT_WIDTH as DEFAULT_WIDTH
@@ -113,6 +114,7 @@ __all__ = [
     "lanes_params",
     "parse_range",
     "orbit",
+    "prepare_orbit",
     "run_lanes",
     "run_lanes_with_stats",
     "parameter_map",
@@ -725,20 +727,78 @@ def continuation(
     return out
 
 
-def _orbit_impl(params, y0, ts, rtol, atol, *, solver, law, max_steps):
-    sol = simulate(
-        params, y0, ts[-1], ts=ts, solver=solver, rtol=rtol, atol=atol, max_steps=max_steps, contact_law=law,
-        exact_ts=True,
-    )  # fmt: skip
-    r_O = jax.vmap(centre_position, in_axes=(0, None))(sol.ys, params)
-    return sol.ys, r_O, sol.status, sol.valid
+def _orbit_program(
+    params: CeltParams,
+    y0: Any,
+    transient_periods: int,
+    periods: int,
+    points_per_period: int,
+    solver: diffrax.AbstractSolver | None,
+    rtol: float,
+    atol: float,
+    max_steps: int,
+    contact_law: AbstractContactLaw | str | None,
+) -> tuple[Callable, tuple, str, np.ndarray]:
+    """`orbit`'s inputs checked, and its program: (function, array arguments, description, save
+    times) for `jaxcelt._executable_cache.compiled` (one program per solver, law, step bound and
+    number of save times; on a CPU compiled with XLA's loop emitters, as the sweep's Lyapunov stage,
+    `jaxcelt._compile_options`)."""
+    if y0 is None:
+        y0 = initial_state(params)
+    for name, v in (("transient_periods", transient_periods), ("periods", periods), ("points_per_period", points_per_period)):
+        if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < (0 if name == "transient_periods" else 1):
+            raise ValueError(f"{name} must be an int >= {0 if name == 'transient_periods' else 1}, got {v!r}")
+    w = float(params.omega_pi)
+    T = 2 * np.pi / w
+    k = np.arange(periods * points_per_period + 1)
+    ts = T * (transient_periods + k / points_per_period)
+    check_state(y0, params, name="y0")
+    y0 = np.asarray(y0, dtype=np.float64)
+    if y0.shape != (13,):
+        raise ValueError(f"'y0' must have shape (13,), got {y0.shape}")
+    for name, tol in (("rtol", rtol), ("atol", atol)):
+        if not (np.ndim(tol) == 0 and np.isfinite(tol) and tol > 0):
+            raise ValueError(f"{name!r} must be a positive finite number, got {tol!r}")
+    if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1:
+        raise ValueError(f"max_steps must be a positive int, got {max_steps!r}")
+    solver, law = solver or DEFAULT_SOLVER, get_contact_law(contact_law)
+    leaves, treedef = jax.tree.flatten(params)
+    args = ([np.asarray(x, np.float64) for x in leaves], y0, ts, np.float64(rtol), np.float64(atol))
+
+    def orbit_program(leaves, y0, ts, rtol, atol):
+        p = jax.tree.unflatten(treedef, leaves)
+        sol = simulate(
+            p, y0, ts[-1], ts=ts, solver=solver, rtol=rtol, atol=atol, max_steps=max_steps, contact_law=law,
+            exact_ts=True,
+        )  # fmt: skip
+        r_O = jax.vmap(centre_position, in_axes=(0, None))(sol.ys, p)
+        return sol.ys, r_O, sol.status, sol.valid
+
+    description = repr((treedef, solver, law, max_steps))
+    return orbit_program, args, description, ts
 
 
-# `orbit`'s program (the solve and the centre positions), per platform: on a CPU compiled with
-# XLA's loop emitters, as the sweep's Lyapunov stage (`jaxcelt._compile_options`)
-_orbit_program = {
-    platform: eqx.filter_jit(_orbit_impl, compiler_options=compiler_options(platform)) for platform in ("cpu", "other")
-}
+def prepare_orbit(
+    params: CeltParams,
+    y0: Any = None,
+    *,
+    transient_periods: int = 200,
+    periods: int = 40,
+    points_per_period: int = 40,
+    solver: diffrax.AbstractSolver | None = None,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    max_steps: int = 1_000_000,
+    contact_law: AbstractContactLaw | str | None = None,
+) -> None:
+    """Start compiling the program `orbit` runs with these arguments: traced now, compiled by XLA
+    on a worker thread. An `orbit` call with the same settings (any parameter values and start)
+    then finds it compiled, or waits for it. Worth it before work that leaves a CPU core idle,
+    e.g. drawing figures. Raises as `orbit` does on bad input."""
+    fn, args, description, _ = _orbit_program(
+        params, y0, transient_periods, periods, points_per_period, solver, rtol, atol, max_steps, contact_law
+    )
+    compile_in_background("orbit", fn, args, description, compiler_options(jax.default_backend()))
 
 
 def orbit(
@@ -757,31 +817,18 @@ def orbit(
     """A densely saved trajectory after the transient, for phase plots (paper Figs. 4-7).
 
     Saves ``points_per_period`` states per forcing period over ``periods`` periods after
-    ``transient_periods``; save times include the section times exactly (``exact_ts``).
+    ``transient_periods``; save times include the section times exactly (``exact_ts``). The
+    program is compiled once per solver, law, ``max_steps`` and number of save times, and kept
+    (`jaxcelt._executable_cache`; `prepare_orbit` compiles it ahead).
 
     Returns dict with ``ts`` (n,), ``ys`` (n, 13), ``r_O`` (n, 3) [m], ``section_index``
     (indices of the section times in ts), ``status``, ``valid``.
     """
-    if y0 is None:
-        y0 = initial_state(params)
-    w = float(params.omega_pi)
-    T = 2 * np.pi / w
-    k = np.arange(periods * points_per_period + 1)
-    ts = T * (transient_periods + k / points_per_period)
-    check_state(y0, params, name="y0")
-    y0 = np.asarray(y0, dtype=np.float64)
-    if y0.shape != (13,):
-        raise ValueError(f"'y0' must have shape (13,), got {y0.shape}")
-    for name, tol in (("rtol", rtol), ("atol", atol)):
-        if not (np.ndim(tol) == 0 and np.isfinite(tol) and tol > 0):
-            raise ValueError(f"{name!r} must be a positive finite number, got {tol!r}")
-    if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1:
-        raise ValueError(f"max_steps must be a positive int, got {max_steps!r}")
-    program = _orbit_program["cpu" if jax.default_backend() == "cpu" else "other"]
-    ys, r_O, status, valid = program(
-        params, y0, ts, jnp.asarray(rtol, jnp.float64), jnp.asarray(atol, jnp.float64),
-        solver=solver or DEFAULT_SOLVER, law=get_contact_law(contact_law), max_steps=max_steps,
-    )  # fmt: skip
+    fn, args, description, ts = _orbit_program(
+        params, y0, transient_periods, periods, points_per_period, solver, rtol, atol, max_steps, contact_law
+    )
+    exe = compiled("orbit", fn, args, description, compiler_options(jax.default_backend()))
+    ys, r_O, status, valid = exe(*args)
     return dict(
         ts=ts,
         ys=np.asarray(ys),

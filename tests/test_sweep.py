@@ -566,3 +566,25 @@ def test_orbit_equals_simulate(paper_params):
         orbit(p, transient_periods=1, periods=1, rtol=-1.0)
     with pytest.raises(ValueError, match="y0"):
         orbit(p, np.zeros(13), transient_periods=1, periods=1)
+    with pytest.raises(ValueError, match="periods"):
+        orbit(p, transient_periods=1, periods=0)
+
+
+def test_prepare_orbit_compiles_the_program_orbit_runs(paper_params):
+    # `prepare_orbit` traces now and compiles on a worker thread; a later `orbit` with the same
+    # settings and another parameter value and start must run that program (one new executable in
+    # the process's store, not two) and give what a fresh `simulate` gives (SAMPLE_ATOL).
+    from jaxcelt import _executable_cache as ec
+    from jaxcelt.sweep import orbit, prepare_orbit
+
+    kw = dict(transient_periods=1, periods=2, points_per_period=5)
+    p1, p2 = paper_params.replace(omega_pi=14.0), paper_params.replace(omega_pi=16.0)
+    n0 = len(ec._MEMORY)
+    assert prepare_orbit(p1, **kw) is None
+    assert len(ec._MEMORY) == n0 + 1
+    o = orbit(p2, jc.initial_state(p2, omega=[0.0, 1.0, 0.0]), **kw)
+    assert len(ec._MEMORY) == n0 + 1
+    sol = jc.simulate(p2, jc.initial_state(p2, omega=[0.0, 1.0, 0.0]), o["ts"][-1], ts=o["ts"], exact_ts=True)
+    np.testing.assert_allclose(o["ys"], np.asarray(sol.ys), rtol=0, atol=SAMPLE_ATOL)
+    with pytest.raises(ValueError, match="atol"):
+        prepare_orbit(p1, atol=0.0, **kw)

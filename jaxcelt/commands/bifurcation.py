@@ -320,13 +320,20 @@ def _figures(args, ds, params, omega0, solver) -> None:
     import numpy as np
 
     import jaxcelt as jc
-    from jaxcelt.sweep import orbit
+    from jaxcelt.sweep import orbit, prepare_orbit
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     from jaxcelt.plotting.bifurcation import bifurcation_figure, orbit_figure
 
+    phase_plots = args.param == "omega_pi" and args.orbits.size
+    orbit_settings = dict(
+        transient_periods=args.transient, periods=args.orbit_periods, solver=solver, rtol=args.rtol, atol=args.atol
+    )
+    if phase_plots:  # compiled by XLA on a worker thread while the diagrams are drawn
+        pw = params.replace(omega_pi=float(args.orbits[0]))
+        prepare_orbit(pw, jc.initial_state(pw, omega=omega0), **orbit_settings)
     fig = bifurcation_figure(ds, color_by="regime")
     fig.savefig(args.out / "bifurcation_regime.png", dpi=150)
     plt.close(fig)
@@ -334,18 +341,10 @@ def _figures(args, ds, params, omega0, solver) -> None:
         fig = bifurcation_figure(ds, color_by="lyapunov")
         fig.savefig(args.out / "bifurcation_lyapunov.png", dpi=150)
         plt.close(fig)
-    if args.param == "omega_pi" and args.orbits.size:
+    if phase_plots:
         for w in args.orbits:
             pw = params.replace(omega_pi=float(w))
-            o = orbit(
-                pw,
-                jc.initial_state(pw, omega=omega0),
-                transient_periods=args.transient,
-                periods=args.orbit_periods,
-                solver=solver,
-                rtol=args.rtol,
-                atol=args.atol,
-            )
+            o = orbit(pw, jc.initial_state(pw, omega=omega0), **orbit_settings)
             label = "" if o["valid"] else "model left its validity (lift-off or n3 <= 0)"
             fig = orbit_figure(o["ts"], o["ys"], o["r_O"], o["section_index"], omega_pi=float(w), label=label)
             fig.savefig(args.out / f"orbit_omega{w:g}.png", dpi=130)

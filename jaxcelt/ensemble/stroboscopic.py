@@ -22,7 +22,7 @@ import numpy as np
 
 from .. import _config  # noqa: F401
 from .._compile_options import compiler_options
-from .._executable_cache import compile_later
+from .._executable_cache import compile_later, gc_paused
 from .._types import Array
 from ..contact import get_contact_law
 from ..diagnostics import centre_position
@@ -267,11 +267,15 @@ def run_lanes_with_stats(
     # are then called as compiled programs. Later chunks of the same shapes find them in JAX's caches.
     pool_args = (pb_p, y0_np[pos_lane].astype(dt), live, jnp.asarray(frac), transient, tols, nocfg, Wd, mesh, vary,
                  opaque_true, (int(drain_factor), int(min_drain_width)))  # fmt: skip
-    pool_compiled = compile_later(_pool_chunk.lower(*pool_args).compile)
+    with gc_paused():
+        pool_lowered = _pool_chunk.lower(*pool_args)
+    pool_compiled = compile_later(pool_lowered.compile)
     lyap_compiled = None
     if cfg.lyapunov_periods > 0 and not compile_only:
         example = (jax.tree_util.tree_map(lambda x: x[:1].repeat(G, 0), pb_np), np.zeros((G, 13)), np.zeros(G))
-        lyap_compiled = compile_later(lyap_fn.lower(*example, static_cfg, mesh).compile)
+        with gc_paused():
+            lyap_lowered = lyap_fn.lower(*example, static_cfg, mesh)
+        lyap_compiled = compile_later(lyap_lowered.compile)
     out, iters, slot_steps = pool_compiled.result()(*pool_args)
     stats = PoolStats(iterations=int(np.asarray(iters).max()), slot_steps=int(np.sum(np.asarray(slot_steps))), width=Wd)
     out = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(out))
