@@ -44,9 +44,9 @@ def gc_paused() -> Iterator[None]:
     """Python's cyclic garbage collector off while the block runs (then back as it was).
 
     Tracing a program that holds an ODE solve allocates millions of objects that live until the
-    trace ends, and every full collection during the trace walks all of them: without collections
-    the sweep's pool, its Lyapunov stage and `jaxcelt.sweep.orbit` trace in about 0.7 of the time
-    (``benchmarks/main_job_compile.py``). The block's cycles are collected later, as usual."""
+    trace ends, and every full collection during the trace walks all of them; without collections
+    the traces of the sweep's pool, its Lyapunov stage and `jaxcelt.sweep.orbit` are faster. The
+    block's cycles are collected later, as usual."""
     enabled = gc.isenabled()
     gc.disable()
     try:

@@ -103,6 +103,22 @@ QUOTES = [
         "docs/bifurcation/README.md",
         lambda: f"{_json('docs/bifurcation/summary_400x300.json')['lanes_invalid']} of the 400 lanes",
     ),
+    # what compilation adds to the main job (benchmarks/main_job_compile.py)
+    (
+        "docs/bifurcation/README.md",
+        lambda: (
+            f"met for the sweep — {_json('docs/bifurcation/main_job_compile.json')['sweep_compile_overhead_s_median']:.1f} s; "
+            f"not for the whole command — "
+            f"{_json('docs/bifurcation/main_job_compile.json')['command_compile_overhead_s_median']:.1f} s."
+        ),
+    ),
+    (
+        "docs/bifurcation/README.md",
+        lambda: "medians of {} s for the sweep and {} s for the whole command".format(
+            ", ".join(f"{x:.2f}" for x in _json("docs/bifurcation/main_job_compile.json")["sweep_compile_overhead_s_each"]),
+            ", ".join(f"{x:.2f}" for x in _json("docs/bifurcation/main_job_compile.json")["command_compile_overhead_s_each"]),
+        ),
+    ),
     # the 100 x 60 parameter map (scripts/map_study.py)
     (
         "docs/map/README.md",
