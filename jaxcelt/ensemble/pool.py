@@ -68,9 +68,11 @@ run longest when lanes are integrated on, belong in a narrow pool (``benchmarks/
 -> docs/bifurcation/drain.json)"""
 SEQUENTIAL_WIDTH = 4
 """widest pool that steps in the inner loop (`run_pool`). XLA's CPU runtime runs a sequence of
-kernels one after the other on the calling thread when every buffer they touch holds at most
-512 bytes; otherwise it hands ready kernels to its thread pool, which costs microseconds per pool
-iteration when the kernels are small. 4 lanes x 13 float64 = 416 bytes."""
+kernels one after the other on the calling thread when each kernel depends on the one before it,
+when there are at most 8 of them, or when every buffer they touch holds at most 512 bytes;
+otherwise it hands ready kernels to its thread pool, which costs microseconds per pool iteration
+when the kernels are small. A step has hundreds of kernels with independent branches, so only the
+last rule is within reach: 4 lanes x 13 float64 = 416 bytes."""
 PILOT_FRACTION = 0.1
 """a lane pauses once after this fraction of its time span and waits for a slot with its
 predicted remaining cost (``benchmarks/bench_schedule.py``)"""
