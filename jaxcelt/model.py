@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+import jax
 import jax.numpy as jnp
 
 from ._math import sincos
@@ -223,8 +224,15 @@ def vector_field_and_normal(
     What the validity monitor needs, at no extra cost where a solver evaluates the field at a
     step's end anyway (FSAL Runge-Kutta methods; the sweep's lane pool).
     """
-    p = params
-    law = get_contact_law(contact_law)
+    return _vector_field_and_normal(t, y, params, get_contact_law(contact_law))
+
+
+# One jit around the whole field: JAX traces it once per argument signature and reuses that
+# trace wherever a program evaluates the field again (every Runge-Kutta stage; diffrax traces a
+# step several times; the tangent field's jvp). XLA inlines the call, so compiled programs are
+# unchanged -- only tracing is cheaper (about 0.3 s off the sweep pool's trace).
+@jax.jit
+def _vector_field_and_normal(t, y, p, law):
     kin = kinematics(t, y, p)
     loads = contact_loads(kin, p, law)
     num, den = normal_force_parts(kin, loads, p)

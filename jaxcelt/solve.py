@@ -63,6 +63,7 @@ class Validity(NamedTuple):
     """maximum arccos(n3) over accepted step ends [rad]"""
 
 
+@jax.jit  # traced once per signature: diffrax traces a solver step several times
 def _invalid_kind(t, y, params, law) -> tuple[Array, Scalar]:
     kin = kinematics(t, y, params)
     num, den = normal_force_parts(kin, contact_loads(kin, params, law), params)
