@@ -33,6 +33,7 @@ __all__ = [
     "clip_to_end",
     "loop_init",
     "loop_step",
+    "solve_to",
     "runtime_checks_as_nan",
 ]
 
@@ -134,3 +135,46 @@ def loop_step(
     )
     tprev1, tnext1 = clip_to_end(tprev1, tnext1, t1, floor, keep)
     return keep, y1, tprev1, tnext1, sstate1, cstate1, sres, cres
+
+
+def solve_to(
+    solver: diffrax.AbstractSolver,
+    term: diffrax.AbstractTerm,
+    controller: diffrax.AbstractAdaptiveStepSizeController,
+    t0: Array,
+    t1: Array,
+    y0: Array,
+    args: Any,
+    max_steps: int,
+) -> tuple[Array, Array, Array]:
+    """``diffeqsolve(term, solver, t0, t1, None, y0, args, stepsize_controller=controller,
+    max_steps=max_steps, throw=False)`` saving only y(t1), as one `jax.lax.while_loop` of
+    `loop_step`: (y(t1), diffrax result, steps taken, accepted and rejected). ``y0``: one array.
+
+    The same steps as diffeqsolve, in a smaller program: no saving, event or adjoint machinery,
+    and t1's 100-ULP floor computed in a loop (`t1_clip_floor`). Differentiable in forward mode
+    (``jax.jvp``, ``jax.jacfwd``); reverse mode is not supported (a while loop)."""
+    R = diffrax.RESULTS
+    wterm = wrap_term(term)
+    tnext, cstate, sstate = loop_init(solver, wterm, controller, t0, t1, y0, args)
+    floor = t1_clip_floor(t1)
+
+    def cond(c):
+        tprev, _, _, _, _, n, result = c
+        return (tprev < t1) & (result == R.successful) & (n < max_steps)
+
+    def body(c):
+        tprev, tnext, y, sstate, cstate, n, result = c
+        keep, y1, tprev, tnext, sstate1, cstate, sres, cres = loop_step(
+            solver, wterm, controller, t1, floor, tprev, tnext, y, args, sstate, cstate
+        )
+        y = jnp.where(keep, y1, y)
+        sstate = jax.tree_util.tree_map(lambda a, b: jnp.where(keep, a, b), sstate1, sstate)
+        result = R.where(result == R.successful, R.where(keep, sres, R.successful), result)
+        result = R.where(result == R.successful, cres, result)
+        return tprev, tnext, y, sstate, cstate, n + 1, result
+
+    init = (jnp.asarray(t0), tnext, y0, sstate, cstate, jnp.zeros((), jnp.int32), R.successful)
+    tprev, _, y, _, _, n, result = jax.lax.while_loop(cond, body, init)
+    result = R.where((result == R.successful) & (tprev < t1), R.max_steps_reached, result)
+    return y, result, n

@@ -116,6 +116,28 @@ def test_adapted_loop_takes_diffeqsolve_steps(solver, step_ts):
     assert float(got_t[n_acc - 1]) == t1  # the last accepted step ends on t1 exactly (clip_to_end)
 
 
+@pytest.mark.parametrize("solver", [diffrax.Tsit5(), diffrax.Dopri5()], ids=lambda s: type(s).__name__)
+def test_solve_to_takes_diffeqsolve_steps(solver):
+    # solve_to against diffeqsolve(SaveAt(t1=True)) of the same problem: the same number of
+    # steps, the same result code, y(t1) to 1e-13 (the same operations compiled in another program:
+    # rounding, not bitwise, is promised); a step budget too small gives max_steps_reached in both
+    t0, t1, y0, k = 0.0, 6.0, jnp.array([1.0, 0.0]), jnp.asarray(4.0)
+    term = diffrax.ODETerm(_forced_oscillator)
+    pid = diffrax.PIDController(rtol=1e-8, atol=1e-10)
+    for max_steps in (1000, 20):
+        sol = diffrax.diffeqsolve(term, solver, t0, t1, None, y0, args=k, stepsize_controller=pid, max_steps=max_steps, throw=False)
+        y, result, n = jax.jit(
+            lambda y0: ad.solve_to(solver, term, pid, jnp.asarray(t0), jnp.asarray(t1), y0, k, max_steps)
+        )(y0)
+        assert int(n) == int(sol.stats["num_steps"]), max_steps
+        assert result == sol.result, max_steps
+        if max_steps == 1000:
+            assert sol.result == diffrax.RESULTS.successful and int(n) > 50
+            np.testing.assert_allclose(np.asarray(y), np.asarray(sol.ys[-1]), rtol=0, atol=1e-13)
+        else:
+            assert sol.result == diffrax.RESULTS.max_steps_reached
+
+
 def test_runtime_checks_as_nan_removes_host_callbacks():
     """Inside `runtime_checks_as_nan` a traced `eqx.error_if` lowers without a host callback and
     returns NaN where it would raise; outside, equinox's default (a callback that raises) holds --
