@@ -28,6 +28,7 @@ import os
 import pickle
 import platform
 import tempfile
+import threading
 import warnings
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -36,6 +37,8 @@ from typing import Any
 import jax
 
 _MEMORY: dict[str, Any] = {}  # key -> executable, or a Future of one being compiled in the background
+_DEFERRED: list[Callable[[], None]] = []  # deferred programs' jobs, not started yet (`start_deferred`)
+_DEFERRED_LOCK = threading.Lock()
 SUBDIR = "jaxcelt-executables"
 
 
@@ -114,6 +117,8 @@ def compiled(name: str, fn: Callable, args: tuple, description: str, options: di
     """
     key = _key(name, description, args, options)
     exe = _MEMORY.get(key)
+    if isinstance(exe, concurrent.futures.Future):
+        start_deferred()  # a deferred program is needed now
     if exe is None:
         exe = _load(key)
         if exe is None:
@@ -143,21 +148,56 @@ def compile_later(compile_fn: Callable[[], Any]) -> concurrent.futures.Future:
     return _compiler().submit(compile_fn)
 
 
-def compile_in_background(name: str, fn: Callable, args: tuple, description: str, options: dict | None = None) -> None:
+def compile_in_background(
+    name: str, fn: Callable, args: tuple, description: str, options: dict | None = None, *, defer: bool = False
+) -> None:
     """Start making the program `compiled` would return: traced and lowered now (in the calling
     thread: tracing is Python), compiled by XLA on a worker thread, so that the caller can trace and
     compile its other programs meanwhile (XLA's compilation releases the GIL). A program already in
-    memory or on disk is loaded now instead."""
+    memory or on disk is loaded now instead.
+
+    ``defer=True``: trace and compile it later, both on a worker thread, once `start_deferred` is
+    called -- by work about to wait on a computation that leaves CPU cores idle (the sweep's
+    Lyapunov stage), by `compiled` or by a later call without ``defer`` for this program."""
     key = _key(name, description, args, options)
     if key in _MEMORY:
+        if not defer:
+            start_deferred()
         return
     exe = _load(key)
     if exe is not None:
         _MEMORY[key] = exe
         return
+    if defer:
+        future: concurrent.futures.Future = concurrent.futures.Future()
+
+        def job() -> None:
+            if not future.set_running_or_notify_cancel():
+                return
+            try:
+                with gc_paused():
+                    lowered = jax.jit(fn).lower(*args)
+                future.set_result(_compile_and_store(key, lowered, options))
+            except BaseException as e:  # reported where the program is used (`compiled`)
+                future.set_exception(e)
+
+        with _DEFERRED_LOCK:
+            _DEFERRED.append(job)
+        _MEMORY[key] = future
+        return
     with gc_paused():
         lowered = jax.jit(fn).lower(*args)
     _MEMORY[key] = compile_later(functools.partial(_compile_and_store, key, lowered, options))
+
+
+def start_deferred() -> None:
+    """Start tracing and compiling the deferred programs (`compile_in_background` with
+    ``defer=True``) on a worker thread, one after another; returns at once."""
+    with _DEFERRED_LOCK:
+        jobs = list(_DEFERRED)
+        _DEFERRED.clear()
+    if jobs:
+        _compiler().submit(lambda: [job() for job in jobs])
 
 
 def _compile_and_store(key: str, lowered: Any, options: dict | None) -> Any:

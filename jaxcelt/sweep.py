@@ -790,15 +790,20 @@ def prepare_orbit(
     atol: float = 1e-10,
     max_steps: int = 1_000_000,
     contact_law: AbstractContactLaw | str | None = None,
+    defer: bool = False,
 ) -> None:
     """Start compiling the program `orbit` runs with these arguments: traced now, compiled by XLA
     on a worker thread. An `orbit` call with the same settings (any parameter values and start)
     then finds it compiled, or waits for it. Worth it before work that leaves a CPU core idle,
-    e.g. drawing figures. Raises as `orbit` does on bad input."""
+    e.g. drawing figures. Raises as `orbit` does on bad input.
+
+    ``defer=True``: trace and compile it on a worker thread when a sweep's Lyapunov stage starts
+    (its padded last group leaves a core idle), or else when `orbit` or ``prepare_orbit`` without
+    ``defer`` first asks for it (`jaxcelt._executable_cache.start_deferred`)."""
     fn, args, description, _ = _orbit_program(
         params, y0, transient_periods, periods, points_per_period, solver, rtol, atol, max_steps, contact_law
     )
-    compile_in_background("orbit", fn, args, description, compiler_options(jax.default_backend()))
+    compile_in_background("orbit", fn, args, description, compiler_options(jax.default_backend()), defer=defer)
 
 
 def orbit(

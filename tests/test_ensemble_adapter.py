@@ -127,7 +127,7 @@ def test_solve_to_takes_diffeqsolve_steps(solver):
     for max_steps in (1000, 20):
         sol = diffrax.diffeqsolve(term, solver, t0, t1, None, y0, args=k, stepsize_controller=pid, max_steps=max_steps, throw=False)
         y, result, n = jax.jit(
-            lambda y0: ad.solve_to(solver, term, pid, jnp.asarray(t0), jnp.asarray(t1), y0, k, max_steps)
+            lambda y0, ms=max_steps: ad.solve_to(solver, term, pid, jnp.asarray(t0), jnp.asarray(t1), y0, k, ms)
         )(y0)
         assert int(n) == int(sol.stats["num_steps"]), max_steps
         assert result == sol.result, max_steps

@@ -171,3 +171,45 @@ def test_background_compilation_error_reaches_the_caller(cache, monkeypatch):
     with pytest.raises(RuntimeError, match="XLA compilation failed"):
         ec.compiled("t", _f, _args(), "sin")
     assert not list(cache.glob("*.bin"))
+
+
+def test_deferred_compilation_waits_for_start_deferred(cache, monkeypatch):
+    """``defer=True`` lowers nothing at the call; `start_deferred` lowers and compiles the program
+    on a worker thread, and `compiled` then returns that program (one lowering in all)."""
+    traced = _traced(monkeypatch)
+    monkeypatch.setattr(ec, "_DEFERRED", [])
+    args = _args()
+    want = np.sin(np.linspace(0.0, 1.0, 3)) * 2.0 + np.arange(3.0)
+    ec.compile_in_background("t", _f, args, "sin", defer=True)
+    ec.compile_in_background("t", _f, args, "sin", defer=True)  # already queued: nothing new
+    assert len(traced) == 0 and len(ec._DEFERRED) == 1
+    ec.start_deferred()
+    exe = ec.compiled("t", _f, args, "sin")
+    assert len(traced) == 1 and not ec._DEFERRED
+    np.testing.assert_allclose(np.asarray(exe(*args)), want, rtol=0, atol=1e-15)
+    assert len(list(cache.glob("*.bin"))) == 1
+
+
+@pytest.mark.parametrize("ask", ["compiled", "compile_in_background"])
+def test_deferred_compilation_starts_when_asked_for(cache, monkeypatch, ask):
+    """A deferred program nobody started is started by `compiled` (no deadlock waiting for it) or
+    by a `compile_in_background` call without ``defer``; an error while it is made reaches the
+    caller of `compiled`."""
+    traced = _traced(monkeypatch)
+    monkeypatch.setattr(ec, "_DEFERRED", [])
+    args = _args()
+    ec.compile_in_background("t", _f, args, "sin", defer=True)
+    if ask == "compile_in_background":
+        ec.compile_in_background("t", _f, args, "sin")
+        assert not ec._DEFERRED  # started
+    exe = ec.compiled("t", _f, args, "sin")
+    assert len(traced) == 1
+    np.testing.assert_allclose(np.asarray(exe(*args)), np.sin(np.asarray(args[1])) * 2.0 + np.arange(3.0), rtol=0, atol=1e-15)
+
+    def bad(leaves, x):
+        raise TypeError("broken program")
+
+    ec.compile_in_background("u", bad, args, "bad", defer=True)
+    with pytest.raises(TypeError, match="broken program"):
+        ec.compiled("u", bad, args, "bad")
+    assert not any(k.startswith("u-") for k in ec._MEMORY)

@@ -56,6 +56,32 @@ def test_sweep_equals_single_simulate(base, paper_params):
         np.testing.assert_allclose(float(sol.validity.min_N), base.min_N[i], rtol=1e-7)
 
 
+def test_lyapunov_stage_equals_celt_lyapunov_and_starts_deferred_work(paper_params):
+    # The sweep's Lyapunov stage (vmapped over the successful lanes in padded groups) against
+    # celt_lyapunov on one lane from that lane's first sample: the same estimator compiled in another
+    # program. Where rounding flips an accept decision the step sequences part and the two differ
+    # at the solver tolerance (rtol 1e-8 over 2 periods), far below 1e-6 1/s; a wrong start, time or
+    # period count changes lambda by ~0.1 1/s. The stage also starts programs deferred for later
+    # (`prepare_orbit(defer=True)`): queued before the sweep, started by it, then used by `orbit`.
+    from jaxcelt import _executable_cache as ec
+    from jaxcelt.sweep import orbit, prepare_orbit
+
+    okw = dict(transient_periods=1, periods=1, points_per_period=3)
+    prepare_orbit(paper_params.replace(omega_pi=14.0), defer=True, **okw)
+    assert ec._DEFERRED
+    vals = np.array([14.0, 17.0])
+    r = bifurcation(paper_params, vals, **{**KW, "chunk_size": 2}, lyapunov_periods=2)
+    assert not ec._DEFERRED
+    for i, w in enumerate(vals):
+        p = paper_params.replace(omega_pi=float(w))
+        lr = jc.celt_lyapunov(p, r.samples[i, 0], periods=2, t0=r.t_samples[i, 0], rtol=1e-8, atol=1e-10, max_steps=4000)
+        assert np.isfinite(r.lyapunov[i]), w
+        np.testing.assert_allclose(r.lyapunov[i], float(lr.exponent), rtol=0, atol=1e-6, err_msg=str(w))
+    n = len(ec._MEMORY)
+    o = orbit(paper_params.replace(omega_pi=17.0), **okw)
+    assert o["status"] == 0 and len(ec._MEMORY) == n  # the deferred program, not a new one
+
+
 def test_failing_lane_is_isolated(base, paper_params):
     # A lane made stiff (mu = 30: the sticking relaxation rate ~ mu g/(a_hat sqrt(eps)),
     # MODEL.md section 10, grows 130x) exhausts max_steps; it is flagged and the other lanes

@@ -275,6 +275,11 @@ def run(args) -> int:
     y0 = np.asarray(jc.initial_state(params, omega=omega0))
     args.out.mkdir(parents=True, exist_ok=True)
     solver = make_solver(args.solver)
+    if _phase_plots(args):  # the phase plots' program: traced and compiled while the sweep leaves a core idle
+        from jaxcelt.sweep import prepare_orbit
+
+        pw = params.replace(omega_pi=float(args.orbits[0]))
+        prepare_orbit(pw, jc.initial_state(pw, omega=omega0), **_orbit_settings(args, solver), defer=True)
     t0 = time.perf_counter()
     with one_line_warnings("bifurcation"):  # e.g. a damaged chunk file recomputed on resume
         sweep(
@@ -315,6 +320,14 @@ def run(args) -> int:
     return 0
 
 
+def _phase_plots(args) -> bool:
+    return bool(not args.no_figures and args.param == "omega_pi" and args.orbits.size)
+
+
+def _orbit_settings(args, solver) -> dict:
+    return dict(transient_periods=args.transient, periods=args.orbit_periods, solver=solver, rtol=args.rtol, atol=args.atol)
+
+
 def _figures(args, ds, params, omega0, solver) -> None:
     import matplotlib
     import numpy as np
@@ -327,11 +340,9 @@ def _figures(args, ds, params, omega0, solver) -> None:
 
     from jaxcelt.plotting.bifurcation import bifurcation_figure, orbit_figure
 
-    phase_plots = args.param == "omega_pi" and args.orbits.size
-    orbit_settings = dict(
-        transient_periods=args.transient, periods=args.orbit_periods, solver=solver, rtol=args.rtol, atol=args.atol
-    )
-    if phase_plots:  # compiled by XLA on a worker thread while the diagrams are drawn
+    phase_plots = _phase_plots(args)
+    orbit_settings = _orbit_settings(args, solver)
+    if phase_plots:  # compiling on a worker thread (started now if the sweep did not) while the diagrams are drawn
         pw = params.replace(omega_pi=float(args.orbits[0]))
         prepare_orbit(pw, jc.initial_state(pw, omega=omega0), **orbit_settings)
     fig = bifurcation_figure(ds, color_by="regime")

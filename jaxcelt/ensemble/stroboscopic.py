@@ -22,7 +22,7 @@ import numpy as np
 
 from .. import _config  # noqa: F401
 from .._compile_options import compiler_options
-from .._executable_cache import compile_later, gc_paused
+from .._executable_cache import compile_later, gc_paused, start_deferred
 from .._types import Array
 from ..contact import get_contact_law
 from ..diagnostics import centre_position
@@ -290,6 +290,9 @@ def run_lanes_with_stats(
         ok = np.flatnonzero(out["status"] == 0)
         ok = ok[np.argsort(-out["num_steps"][ok], kind="stable")]  # similar cost side by side
         lyap = lyap_compiled.result()
+        # the stage's last group is padded with copies of one lane, which leaves a core idle on a
+        # CPU: programs deferred for later (e.g. the CLI's phase plots) are traced and compiled now
+        start_deferred()
         for i in range(0, len(ok), G):
             idx = pad_lanes(ok[i : i + G], G)
             lam = lyap(
