@@ -2,14 +2,15 @@
 
 jaxcelt uses diffrax's public API everywhere except where it has to reproduce what
 `diffrax.diffeqsolve` does inside its loop: the lane pool (`jaxcelt.ensemble`) steps many
-solves side by side in its own while loop and must take the same steps as `diffeqsolve`, and
+solves side by side in its own while loop and must take the same steps as `diffeqsolve`, the
+Lyapunov exponent's per-period solves take them in a smaller program (`solve_to`), and
 `jaxcelt.solve` passes diffrax's "use the step-size tolerances" marker to an implicit solver's
 root finder. The names below are not re-exported by diffrax or equinox, or mirror the body of
 diffrax's integration loop (``diffrax/_integrate.py``: ``loop``, ``body_fun_aux``,
 ``_clip_to_end``), so they can change in any release. The versions they were written against
 are the ranges pinned in ``pyproject.toml``; ``tests/test_ensemble_adapter.py`` checks that the
 installed diffrax and equinox are inside them, that the names still exist, and that
-`loop_init` + `loop_step` take the same steps as `diffrax.diffeqsolve` on a small ODE.
+`loop_init` + `loop_step` and `solve_to` take the same steps as `diffrax.diffeqsolve` on a small ODE.
 """
 
 from __future__ import annotations
