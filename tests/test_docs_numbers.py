@@ -118,6 +118,14 @@ QUOTES = [
             ", ".join(f"{x:.2f}" for x in _json("docs/bifurcation/main_job_compile.json")["command_compile_overhead_s_each"]),
         ),
     ),
+    # XLA's loop emitters for the Lyapunov stage (benchmarks/compile_options.py)
+    (
+        "docs/bifurcation/README.md",
+        lambda: "compile {:.2f} s → {:.2f} s, run {:.2f} s → {:.2f} s, exponents within {:.1e})".format(
+            *(_json("docs/performance/compile_options.json")["runs"][v][k] for k in ("compile_s", "run_best_of_3_s") for v in ("default", "loop")),
+            _json("docs/performance/compile_options.json")["lyapunov_max_abs_diff"],
+        ).replace("e-09", "e-9"),
+    ),
     # the 100 x 60 parameter map (scripts/map_study.py)
     (
         "docs/map/README.md",
