@@ -21,7 +21,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from ._math import sincos
+from ._math import cross3, matvec3, sincos
 from ._types import Scalar, ScalarLike, State, Vec3
 from .contact import AbstractContactLaw, ContactKinematics, ContactLoads, get_contact_law
 from .params import CeltParams
@@ -72,7 +72,7 @@ def contact_geometry(n: Vec3, omega: Vec3, p: CeltParams) -> Geometry:
     An = A * n
     s = jnp.sqrt(jnp.dot(n, An))
     r = -An / s
-    n_dot = -jnp.cross(omega, n)
+    n_dot = -cross3(omega, n)
     A_ndot = A * n_dot
     r_dot = -A_ndot / s + jnp.dot(n, A_ndot) * An / s**3
     return Geometry(r=r, rho=r - jnp.stack([p.k1, p.k2, p.k3]), r_dot=r_dot, n_dot=n_dot)
@@ -96,7 +96,7 @@ def horizontal_frame(n: Vec3, psi: ScalarLike) -> Frame:
     """
     e2 = jnp.array([0.0, 1.0, 0.0], dtype=n.dtype)
     u = (e2 - n[1] * n) / jnp.sqrt(1.0 - n[1] ** 2)
-    w = jnp.cross(u, n)
+    w = cross3(u, n)
     s, c = sincos(psi)
     return Frame(E1=c * w - s * u, E2=s * w + c * u)
 
@@ -108,7 +108,7 @@ def patch_frame(n: Vec3) -> tuple[Vec3, Vec3]:
     """
     e1 = jnp.array([1.0, 0.0, 0.0], dtype=n.dtype)
     e_x = (e1 - n[0] * n) / jnp.sqrt(1.0 - n[0] ** 2)
-    return e_x, jnp.cross(n, e_x)
+    return e_x, cross3(n, e_x)
 
 
 def base_velocity(t: ScalarLike, frame: Frame, p: CeltParams) -> Vec3:
@@ -142,7 +142,7 @@ def kinematics(t: ScalarLike, y: State, p: CeltParams) -> Kinematics:
     geom = contact_geometry(n, omega, p)
     frame = horizontal_frame(n, psi)
     e_x, e_y = patch_frame(n)
-    v_A = v + jnp.cross(omega, geom.rho)
+    v_A = v + cross3(omega, geom.rho)
     v_s = (v_A - base_velocity(t, frame, p)) / p.a_hat
     v_r = v_s + geom.r_dot / p.a_hat
     ck = ContactKinematics(
@@ -165,10 +165,10 @@ def _solve_B(p: CeltParams, x: Vec3) -> Vec3:
     well conditioned; unlike ``jnp.linalg.solve`` (a LAPACK call per lane) this fuses under
     ``jax.vmap`` and halves the cost of the right-hand side in sweeps."""
     B = p.B
-    c0, c1, c2 = jnp.cross(B[1], B[2]), jnp.cross(B[2], B[0]), jnp.cross(B[0], B[1])
+    c0, c1, c2 = cross3(B[1], B[2]), cross3(B[2], B[0]), cross3(B[0], B[1])
     det = jnp.dot(B[0], c0)
     # B symmetric: rows of the adjugate are c0, c1, c2.
-    return jnp.stack([jnp.dot(c0, x), jnp.dot(c1, x), jnp.dot(c2, x)]) / det
+    return matvec3(jnp.stack([c0, c1, c2]), x) / det
 
 
 def normal_force_parts(kin: Kinematics, loads: ContactLoads, p: CeltParams) -> tuple[Scalar, Scalar]:
@@ -179,17 +179,17 @@ def normal_force_parts(kin: Kinematics, loads: ContactLoads, p: CeltParams) -> t
     Numerator in m/s^2, denominator in 1/kg. The denominator must stay > 0.
     """
     w, n, rho = kin.omega, kin.n, kin.geom.rho
-    rxn = jnp.cross(rho, n)
-    Bw = p.B @ w
+    rxn = cross3(rho, n)
+    Bw = matvec3(p.B, w)
     c = jnp.dot(kin.v_A, n)
     num = (
         p.g
-        + jnp.dot(jnp.cross(w, rho), jnp.cross(w, n))
-        - jnp.dot(jnp.cross(w, kin.geom.r_dot), n)
-        + jnp.dot(rxn, _solve_B(p, jnp.cross(w, Bw)))
+        + jnp.dot(cross3(w, rho), cross3(w, n))
+        - jnp.dot(cross3(w, kin.geom.r_dot), n)
+        + jnp.dot(rxn, _solve_B(p, cross3(w, Bw)))
         - p.kappa * c
     )
-    lever = jnp.cross(rho, n + loads.t) + loads.m_s + loads.m_r
+    lever = cross3(rho, n + loads.t) + loads.m_s + loads.m_r
     den = 1.0 / p.m + jnp.dot(rxn, _solve_B(p, lever))
     return num, den
 
@@ -239,9 +239,9 @@ def _vector_field_and_normal(t, y, p, law):
     N = num / den
     v, w, n = kin.v, kin.omega, kin.n
     F = N * (n + loads.t)
-    v_dot = -jnp.cross(w, v) - p.g * n + F / p.m
-    torque = jnp.cross(kin.geom.rho, F) + N * (loads.m_s + loads.m_r)
-    w_dot = _solve_B(p, torque - jnp.cross(w, p.B @ w))
+    v_dot = -cross3(w, v) - p.g * n + F / p.m
+    torque = cross3(kin.geom.rho, F) + N * (loads.m_s + loads.m_r)
+    w_dot = _solve_B(p, torque - cross3(w, matvec3(p.B, w)))
     rC_dot = kin.frame.to_global(v, n)
     psi_dot = (w[0] * n[0] + w[2] * n[2]) / (1.0 - n[1] ** 2)
     return jnp.concatenate([v_dot, w_dot, kin.geom.n_dot, rC_dot, psi_dot[None]]), (N, den)
