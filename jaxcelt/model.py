@@ -85,7 +85,9 @@ class Frame(NamedTuple):
     E2: Vec3
 
     def to_global(self, x: Vec3, n: Vec3) -> Vec3:
-        return jnp.stack([jnp.dot(self.E1, x), jnp.dot(self.E2, x), jnp.dot(n, x)])
+        # written out, not three jnp.dot: the products then fuse into the output kernel (the
+        # pool's step ~8 % faster; `jaxcelt._math` says why other dot products stay jnp.dot)
+        return matvec3(jnp.stack([self.E1, self.E2, n]), x)
 
 
 def horizontal_frame(n: Vec3, psi: ScalarLike) -> Frame:
