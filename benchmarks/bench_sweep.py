@@ -244,8 +244,9 @@ def main():
     ap.add_argument("--quick", action="store_true", help="40 freq x 40 periods")
     ap.add_argument(
         "--reps", type=int, default=3,
-        help="runs of each stop-at-invalid jaxcelt / numba timing (median reported: this VM's speed drifts by "
-        "10-20 %% between minutes); the slower integrate-on and lane-by-lane timings run once",
+        help="runs of each jaxcelt pool / numba ensemble timing, both modes (median reported: this VM's speed "
+        "drifts by 10-20 %% between minutes, and one integrate-on run took 36 %% longer than its repeats); the "
+        "lane-by-lane and scipy loops run once",
     )  # fmt: skip
     ap.add_argument("--out", type=Path, default=Path("docs/bifurcation"))
     a = ap.parse_args()
@@ -304,7 +305,7 @@ def main():
     if len(devs) > 1:
         runs.insert(1, ("pool_stop_on_invalid_1dev", "pool", True, devs[:1], None))
     for key, sched, stop, dv, solver in runs:
-        res[f"jaxcelt_{key}"] = time_jaxcelt(p, vals, transient, a, sched, stop, dv, solver, a.reps if stop else 1)
+        res[f"jaxcelt_{key}"] = time_jaxcelt(p, vals, transient, a, sched, stop, dv, solver, a.reps)
         print(key, res[f"jaxcelt_{key}"], flush=True)
     res["per_lane_eval_cost"] = eval_costs(p, vals, a.width)
     print("per-lane evaluation cost (vmapped, one device)", res["per_lane_eval_cost"], flush=True)
@@ -314,7 +315,7 @@ def main():
     nm.dopri_ensemble(Y0[:2].copy(), TS[:2, :1].copy(), PP[:2].copy(), B, Bi, a.rtol, a.atol, 10**7, True)
     for stop in (True, False):
         key = "numba_dp5_ensemble" + ("_stop_on_invalid" if stop else "")
-        res[key] = _numba_ensemble(Y0, TS, PP, B, Bi, a, stop, a.reps if stop else 1)
+        res[key] = _numba_ensemble(Y0, TS, PP, B, Bi, a, stop, a.reps)
         print(key, res[key], flush=True)
 
     # 3. lane by lane on an evenly spread subset, full length, extrapolated to all lanes

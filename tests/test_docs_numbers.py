@@ -32,6 +32,17 @@ def _bench():
     return _json("docs/bifurcation/bench_sweep_400x300.json")
 
 
+def _processes():
+    return _json("docs/bifurcation/processes.json")
+
+
+def _runs(key: str) -> str:
+    """A pool timing as the benchmark table gives it: median (each run; + compile)."""
+    r = _bench()[key]
+    each = ", ".join(f"{x:.1f}" for x in r["seconds_each_run"])
+    return f"{r['seconds']:.1f} ({each}; + {r['compile_seconds']:.1f} compile)"
+
+
 def _vs(ratio: float) -> str:
     """A wall-time ratio jaxcelt / other as the docs word it."""
     return f"{ratio:.2f}× slower" if ratio >= 1 else f"{1 / ratio:.2f}× faster"
@@ -139,12 +150,7 @@ QUOTES = [
     ("docs/bifurcation/README.md", lambda: f"**{_bench()['summary']['jaxcelt_dopri8_stop_on_invalid_s']:.2f}**"),
     # the numba loop's own method (Dopri5): equal work step for step
     ("docs/bifurcation/README.md", lambda: f"**{_bench()['jaxcelt_pool_stop_on_invalid_dopri5']['seconds']:.2f}**"),
-    (
-        "docs/bifurcation/README.md",
-        lambda: (
-            f"{_bench()['jaxcelt_pool_dopri5']['seconds']:.1f} (+ {_bench()['jaxcelt_pool_dopri5']['compile_seconds']:.1f} compile)"
-        ),
-    ),
+    ("docs/bifurcation/README.md", lambda: _runs("jaxcelt_pool_dopri5")),
     (
         "docs/bifurcation/README.md",
         lambda: f"{1 / _bench()['summary']['wall_ratio_dopri5_vs_numba_ensemble_stop']:.2f}× faster stopping",
@@ -159,10 +165,34 @@ QUOTES = [
             _bench()["jaxcelt_pool_stop_on_invalid_dopri5"]["seconds"], _bench()["jaxcelt_pool_dopri5"]["seconds"]
         ),
     ),
+    ("docs/bifurcation/README.md", lambda: _runs("jaxcelt_pool")),
     (
         "docs/bifurcation/README.md",
-        lambda: (
-            f"{_bench()['jaxcelt_pool']['seconds']:.1f} (+ {_bench()['jaxcelt_pool']['compile_seconds']:.1f} compile)"
+        lambda: "| {:.1f} ({}) | {:.1f} ({}) |".format(
+            *(
+                v
+                for k in ("numba_dp5_ensemble_stop_on_invalid", "numba_dp5_ensemble")
+                for v in (_bench()[k]["seconds"], ", ".join(f"{x:.1f}" for x in _bench()[k]["seconds_each_run"]))
+            )
+        ),
+    ),
+    # the lanes that run to max_steps integrating on (Tsit5), against numba and Dopri5
+    (
+        "docs/bifurcation/README.md",
+        lambda: "{} lanes that run to max_steps set the critical path ({:.1f} M steps in all, numba's loop {:.1f} M; "
+        "Dopri5 {:.1f} M".format(
+            _bench()["jaxcelt_pool"]["status_counts"]["1"],
+            _bench()["jaxcelt_pool"]["total_steps"] / 1e6,
+            _bench()["numba_dp5_ensemble"]["total_steps"] / 1e6,
+            _bench()["jaxcelt_pool_dopri5"]["total_steps"] / 1e6,
+        ),
+    ),
+    (
+        "docs/bifurcation/max-steps.md",
+        lambda: "ends {} lanes with status 3 and still sends {} to max_steps: {:.1f} M steps in all".format(
+            _bench()["jaxcelt_pool"]["status_counts"]["3"],
+            _bench()["jaxcelt_pool"]["status_counts"]["1"],
+            _bench()["jaxcelt_pool"]["total_steps"] / 1e6,
         ),
     ),
     ("docs/bifurcation/README.md", lambda: f"{_bench()['summary']['jaxcelt_stop_on_invalid_1dev_s']:.1f} (+"),
@@ -207,6 +237,27 @@ QUOTES = [
     (
         "docs/performance.md",
         lambda: f"numba ensemble {_bench()['summary']['wall_ratio_vs_numba_ensemble_integrate_on']:.2f});",
+    ),
+    # one process with a device per core against one pinned process per core (benchmarks/bench_processes.py)
+    *[
+        (
+            "docs/bifurcation/README.md",
+            lambda m=m: "| " + " | ".join(
+                "{:.2f} ({})".format(
+                    _processes()[m]["seconds"][k], ", ".join(f"{x:.2f}" for x in _processes()[m]["seconds_each_run"][k])
+                )
+                for k in ("devices", "processes", "numba")
+            ) + " |",
+        )
+        for m in ("stop", "on")
+    ],
+    (
+        "docs/bifurcation/README.md",
+        lambda: f"{_processes()['on']['ratio_numba_over_processes']:.2f}× the numba loop's speed",
+    ),
+    (
+        "docs/bifurcation/README.md",
+        lambda: f"process per core, {_processes()['on']['ratio_numba_over_processes']:.2f}× faster, `processes.json` above",
     ),
     # per-step cost table (benchmarks/bench_step_parts.py)
     (

@@ -1,0 +1,191 @@
+"""One process with a JAX device per core against one single-device process per core, pinned.
+
+The 400 x 300 sweep of `bench_sweep.py` (omega_pi 10..20 rad/s from rest, rtol 1e-8, Tsit5, lane pool
+of 96 slots per device), stopping lanes at invalid states and integrating every lane on, three ways
+in one run, alternating, each timed after compilation:
+
+* ``devices``: one process, ``jax_num_cpu_devices = cores``, lanes sharded over the devices (what
+  ``jaxcelt bifurcation`` does on a CPU);
+* ``processes``: one worker process per core, each pinned to its core (``os.sched_setaffinity``
+  before JAX starts) with one JAX device, taking the lanes that device would get (lane d, d + cores,
+  ...); the time is from the start signal until the last worker is done;
+* the numba DP5(4) ensemble (``_numba_model.dopri_ensemble``, one thread per core), for the ratio.
+
+Both jaxcelt variants run the same lanes with the same settings, but as different compiled programs
+(one program over several devices against one single-device program per process), which may round
+differently: a lane that has left the model's validity is chaotic, and over hundreds of periods it may
+then take other steps. The script records each variant's total steps and how many lanes differ.
+
+    .venv/bin/python benchmarks/bench_processes.py --out docs/bifurcation   # -> processes.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import multiprocessing as mp
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+
+
+def _setup(n_freq: int, transient: int, sample: int, stop: bool, devices: int):
+    import jax
+
+    jax.config.update("jax_num_cpu_devices", devices)
+    import jaxcelt as jc
+    from jaxcelt.sweep import SweepConfig
+
+    p = jc.CeltParams.paper()
+    vals = np.linspace(10.0, 20.0, n_freq)
+    cfg = SweepConfig(
+        transient_periods=transient, sample_periods=sample, rtol=1e-8, atol=1e-10, stop_on_invalid=stop
+    )  # fmt: skip
+    return jc, p, vals, cfg
+
+
+def _worker(core: int, cores: int, a: dict, stop: bool, conn) -> None:
+    os.sched_setaffinity(0, {core})  # before JAX starts: its CPU runtime sizes its thread pool to one core
+    jc, p, vals, cfg = _setup(a["n_freq"], a["transient"], a["sample"], stop, 1)
+    import jax
+
+    from jaxcelt.ensemble.stroboscopic import run_lanes_with_stats
+    from jaxcelt.sweep import lanes_params
+
+    mine = np.arange(core, len(vals), cores)
+    pb = lanes_params(p, "omega_pi", vals[mine])
+    y0 = np.tile(np.asarray(jc.initial_state(p)), (len(mine), 1))
+    dev = jax.devices()
+    t = time.perf_counter()
+    run_lanes_with_stats(pb, y0, cfg, pad_to=len(mine), compile_only=True, devices=dev)
+    conn.send(("compiled", time.perf_counter() - t))
+    while conn.recv() == "go":
+        t = time.perf_counter()
+        out, _ = run_lanes_with_stats(pb, y0, cfg, pad_to=len(mine), devices=dev)
+        conn.send(("done", time.perf_counter() - t, mine, out["num_steps"], out["status"], out["samples"]))
+    conn.close()
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--n-freq", type=int, default=400)
+    ap.add_argument("--periods", type=int, default=300)
+    ap.add_argument("--sample", type=int, default=100)
+    ap.add_argument("--reps", type=int, default=3, help="alternating runs of each variant per mode (medians reported)")
+    ap.add_argument("--modes", default="stop,on", help="'stop' (stop at invalid states), 'on' (integrate on)")
+    ap.add_argument("--out", type=Path, default=None, help="folder for processes.json (optional)")
+    a = ap.parse_args()
+    cores = len(os.sched_getaffinity(0))
+    transient = a.periods - a.sample
+    jc, p, vals, _ = _setup(a.n_freq, transient, a.sample, True, cores)
+    import jax
+
+    sys.path.insert(0, str(HERE))
+    import _numba_model as nm
+
+    from jaxcelt.ensemble.stroboscopic import run_lanes_with_stats
+    from jaxcelt.sweep import SweepConfig, lanes_params
+    from jaxcelt.versions import versions
+
+    V = versions()
+    print(" ".join(f"{k}={v}" for k, v in V.items()), flush=True)
+    res: dict = dict(
+        versions=V,
+        cores=cores,
+        load_average_at_start=os.getloadavg(),
+        config=dict(n_freq=a.n_freq, periods=a.periods, sample=a.sample, rtol=1e-8, atol=1e-10, solver="Tsit5"),
+    )
+    devs = jax.devices()
+    pb = lanes_params(p, "omega_pi", vals)
+    y0 = np.tile(np.asarray(jc.initial_state(p)), (len(vals), 1))
+    P, B, Bi = nm.pack(p)
+    PP = np.tile(P, (len(vals), 1))
+    PP[:, nm.WPI] = vals
+    TS = np.stack([2 * np.pi / w * np.arange(transient, a.periods) for w in vals])
+    nm.dopri_ensemble(y0[:2].copy(), TS[:2, :1].copy(), PP[:2].copy(), B, Bi, 1e-8, 1e-10, 10**7, True)
+    ctx = mp.get_context("spawn")
+    for mode in a.modes.split(","):
+        stop = mode == "stop"
+        cfg = SweepConfig(
+            transient_periods=transient, sample_periods=a.sample, rtol=1e-8, atol=1e-10, stop_on_invalid=stop
+        )
+        t = time.perf_counter()
+        run_lanes_with_stats(pb, y0, cfg, pad_to=len(vals), compile_only=True, devices=devs)
+        compile_devices = time.perf_counter() - t
+        pipes, procs = [], []
+        t = time.perf_counter()
+        for c in range(cores):
+            here, there = ctx.Pipe()
+            pr = ctx.Process(
+                target=_worker,
+                args=(sorted(os.sched_getaffinity(0))[c], cores, vars(a) | {"transient": transient}, stop, there),
+            )
+            pr.start()
+            pipes.append(here)
+            procs.append(pr)
+        compile_workers = [pp.recv()[1] for pp in pipes]
+        start_workers = time.perf_counter() - t
+        runs: dict = {"devices": [], "processes": [], "numba": []}
+        for _ in range(a.reps):
+            t = time.perf_counter()
+            out, _ = run_lanes_with_stats(pb, y0, cfg, pad_to=len(vals), devices=devs)
+            runs["devices"].append(time.perf_counter() - t)
+            t = time.perf_counter()
+            for pp in pipes:
+                pp.send("go")
+            got = [pp.recv() for pp in pipes]
+            runs["processes"].append(time.perf_counter() - t)
+            t = time.perf_counter()
+            _, st_nb, _, status_nb = nm.dopri_ensemble(y0, TS, PP, B, Bi, 1e-8, 1e-10, 10**6, stop)
+            runs["numba"].append(time.perf_counter() - t)
+            print(mode, {k: round(v[-1], 2) for k, v in runs.items()}, flush=True)
+        for pp in pipes:
+            pp.send("stop")
+        for pr in procs:
+            pr.join()
+        steps = np.zeros(len(vals), dtype=np.int64)
+        status = np.zeros(len(vals), dtype=np.int64)
+        samples = np.zeros_like(out["samples"])
+        for _, _, mine, st, stt, smp in got:
+            steps[mine], status[mine], samples[mine] = st, stt, smp
+        fin = np.isfinite(out["samples"]) & np.isfinite(samples)  # stopped lanes' later samples are inf
+        with np.errstate(invalid="ignore"):
+            diff = np.abs(samples - out["samples"])
+        med = {k: float(np.median(v)) for k, v in runs.items()}
+        res[mode] = dict(
+            seconds=med,
+            seconds_each_run=runs,
+            compile_seconds_devices=compile_devices,
+            compile_seconds_each_worker=compile_workers,
+            worker_start_and_compile_seconds=start_workers,
+            total_steps_devices=int(out["num_steps"].sum()),
+            total_steps_processes=int(steps.sum()),
+            total_steps_numba=int(st_nb.sum()),
+            lanes_with_other_steps_or_status=int(np.sum((steps != out["num_steps"]) | (status != out["status"]))),
+            max_abs_sample_difference=float(np.max(diff, where=fin, initial=0.0)),
+            status_counts_devices={int(k): int(v) for k, v in zip(*np.unique(out["status"], return_counts=True))},
+            status_counts_processes={int(k): int(v) for k, v in zip(*np.unique(status, return_counts=True))},
+            status_counts_numba={int(k): int(v) for k, v in zip(*np.unique(status_nb, return_counts=True))},
+            ratio_numba_over_devices=med["numba"] / med["devices"],
+            ratio_numba_over_processes=med["numba"] / med["processes"],
+        )
+        print(
+            mode,
+            json.dumps(res[mode]["seconds"]),
+            "lanes that differ:",
+            res[mode]["lanes_with_other_steps_or_status"],
+            flush=True,
+        )
+    if a.out is not None:
+        a.out.mkdir(parents=True, exist_ok=True)
+        (a.out / "processes.json").write_text(json.dumps(res, indent=1) + "\n")
+        print("wrote", a.out / "processes.json")
+
+
+if __name__ == "__main__":
+    main()
