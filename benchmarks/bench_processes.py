@@ -6,9 +6,9 @@ in one run, alternating, each timed after compilation:
 
 * ``devices``: one process, ``jax_num_cpu_devices = cores``, lanes sharded over the devices (what
   ``jaxcelt bifurcation`` does on a CPU);
-* ``processes``: one worker process per core, each pinned to its core (``os.sched_setaffinity``
-  before JAX starts) with one JAX device, taking the lanes that device would get (lane d, d + cores,
-  ...); the time is from the start signal until the last worker is done;
+* ``processes``: ``devices=jaxcelt.HostProcesses(cores)``, one worker process per core, each pinned
+  to its core with one JAX device, taking the lanes that device would get (lane d, d + cores, ...);
+  the time includes sending the lanes and receiving the results;
 * the numba DP5(4) ensemble (``_numba_model.dopri_ensemble``, one thread per core), for the ratio.
 
 Both jaxcelt variants run the same lanes with the same settings, but as different compiled programs
@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import multiprocessing as mp
 import os
 import sys
 import time
@@ -47,28 +46,6 @@ def _setup(n_freq: int, transient: int, sample: int, stop: bool, devices: int):
         transient_periods=transient, sample_periods=sample, rtol=1e-8, atol=1e-10, stop_on_invalid=stop
     )  # fmt: skip
     return jc, p, vals, cfg
-
-
-def _worker(core: int, cores: int, a: dict, stop: bool, conn) -> None:
-    os.sched_setaffinity(0, {core})  # before JAX starts: its CPU runtime sizes its thread pool to one core
-    jc, p, vals, cfg = _setup(a["n_freq"], a["transient"], a["sample"], stop, 1)
-    import jax
-
-    from jaxcelt.ensemble.stroboscopic import run_lanes_with_stats
-    from jaxcelt.sweep import lanes_params
-
-    mine = np.arange(core, len(vals), cores)
-    pb = lanes_params(p, "omega_pi", vals[mine])
-    y0 = np.tile(np.asarray(jc.initial_state(p)), (len(mine), 1))
-    dev = jax.devices()
-    t = time.perf_counter()
-    run_lanes_with_stats(pb, y0, cfg, pad_to=len(mine), compile_only=True, devices=dev)
-    conn.send(("compiled", time.perf_counter() - t))
-    while conn.recv() == "go":
-        t = time.perf_counter()
-        out, _ = run_lanes_with_stats(pb, y0, cfg, pad_to=len(mine), devices=dev)
-        conn.send(("done", time.perf_counter() - t, mine, out["num_steps"], out["status"], out["samples"]))
-    conn.close()
 
 
 def main() -> None:
@@ -108,7 +85,6 @@ def main() -> None:
     PP[:, nm.WPI] = vals
     TS = np.stack([2 * np.pi / w * np.arange(transient, a.periods) for w in vals])
     nm.dopri_ensemble(y0[:2].copy(), TS[:2, :1].copy(), PP[:2].copy(), B, Bi, 1e-8, 1e-10, 10**7, True)
-    ctx = mp.get_context("spawn")
     for mode in a.modes.split(","):
         stop = mode == "stop"
         cfg = SweepConfig(
@@ -117,42 +93,24 @@ def main() -> None:
         t = time.perf_counter()
         run_lanes_with_stats(pb, y0, cfg, pad_to=len(vals), compile_only=True, devices=devs)
         compile_devices = time.perf_counter() - t
-        pipes, procs = [], []
+        hp = jc.HostProcesses(cores)
         t = time.perf_counter()
-        for c in range(cores):
-            here, there = ctx.Pipe()
-            pr = ctx.Process(
-                target=_worker,
-                args=(sorted(os.sched_getaffinity(0))[c], cores, vars(a) | {"transient": transient}, stop, there),
-            )
-            pr.start()
-            pipes.append(here)
-            procs.append(pr)
-        compile_workers = [pp.recv()[1] for pp in pipes]
-        start_workers = time.perf_counter() - t
+        run_lanes_with_stats(pb, y0, cfg, pad_to=len(vals), compile_only=True, devices=hp)
+        compile_workers = time.perf_counter() - t  # worker start (imports) and compilation, in parallel
         runs: dict = {"devices": [], "processes": [], "numba": []}
         for _ in range(a.reps):
             t = time.perf_counter()
             out, _ = run_lanes_with_stats(pb, y0, cfg, pad_to=len(vals), devices=devs)
             runs["devices"].append(time.perf_counter() - t)
             t = time.perf_counter()
-            for pp in pipes:
-                pp.send("go")
-            got = [pp.recv() for pp in pipes]
+            got, _ = run_lanes_with_stats(pb, y0, cfg, pad_to=len(vals), devices=hp)
             runs["processes"].append(time.perf_counter() - t)
             t = time.perf_counter()
             _, st_nb, _, status_nb = nm.dopri_ensemble(y0, TS, PP, B, Bi, 1e-8, 1e-10, 10**6, stop)
             runs["numba"].append(time.perf_counter() - t)
             print(mode, {k: round(v[-1], 2) for k, v in runs.items()}, flush=True)
-        for pp in pipes:
-            pp.send("stop")
-        for pr in procs:
-            pr.join()
-        steps = np.zeros(len(vals), dtype=np.int64)
-        status = np.zeros(len(vals), dtype=np.int64)
-        samples = np.zeros_like(out["samples"])
-        for _, _, mine, st, stt, smp in got:
-            steps[mine], status[mine], samples[mine] = st, stt, smp
+        hp.close()
+        steps, status, samples = got["num_steps"], got["status"], got["samples"]
         fin = np.isfinite(out["samples"]) & np.isfinite(samples)  # stopped lanes' later samples are inf
         with np.errstate(invalid="ignore"):
             diff = np.abs(samples - out["samples"])
@@ -161,8 +119,7 @@ def main() -> None:
             seconds=med,
             seconds_each_run=runs,
             compile_seconds_devices=compile_devices,
-            compile_seconds_each_worker=compile_workers,
-            worker_start_and_compile_seconds=start_workers,
+            worker_start_and_compile_seconds=compile_workers,
             total_steps_devices=int(out["num_steps"].sum()),
             total_steps_processes=int(steps.sum()),
             total_steps_numba=int(st_nb.sum()),

@@ -12,6 +12,7 @@ from .contact import CONTACT_LAWS, AbstractContactLaw, Coulomb, CoulombSpin, Gen
 from .data import MeasuredData, Trajectory, generate_data, load_data, save_data
 from .diagnostics import Diagnostics, centre_position, diagnostics, energy, tilt
 from .elliptic import contact_integrals, ellipke
+from .ensemble import HostProcesses
 from .fit import FitResult, fit, project_state  # noqa: F811  (jaxcelt.fit is the function)
 from .integral_law import CustomProfile, HertzProfile, IntegralLaw, UniformProfile, patch_integrals, profile_moments
 from .ladder import Scene, hertz_params, run_ladder
@@ -43,6 +44,7 @@ __all__ = [
     "save_data",
     "AbstractContactLaw",
     "SweepResult",
+    "HostProcesses",
     "bifurcation",
     "celt_lyapunov",
     "continuation",

@@ -55,6 +55,10 @@ Execution model
   11.3 s on 2 devices vs 23.6 s on 1 (docs/bifurcation/README.md). Results agree with the
   1-device run to ~1e-11 over a few periods (tests), not bitwise (a different compiled
   program): over hundreds of periods chaotic lanes diverge from that seed like any other.
+  The devices of one process share XLA's CPU thread pool; ``devices=HostProcesses("auto")``
+  (`jaxcelt.ensemble.processes`; ``--host-processes auto``) runs the lanes in one pinned
+  single-device worker process per core instead (steadier and faster integrating every lane
+  on; docs/bifurcation/README.md).
 
 Multi-host (several processes or machines, each with local devices)
 -------------------------------------------------------------------
@@ -504,7 +508,9 @@ def sweep(
             use rtol >= 1e-6; results come back as float64 arrays, the Lyapunov stage runs
             in float64). Part of the dataset's fingerprint.
         width: batch slots per device of the pool (default `DEFAULT_WIDTH`).
-        devices: devices to shard each chunk over (default all local devices).
+        devices: devices to shard each chunk over (default all local devices), or a
+            `jaxcelt.HostProcesses`: worker processes, one pinned to each CPU core with one
+            device each (`jaxcelt.ensemble.processes`).
         out: directory; write the dataset chunk by chunk there and resume a previous,
             interrupted run of the same sweep (`jaxcelt.dataset`). Required when several
             processes run the sweep together (`jax.distributed`; see the module docstring).

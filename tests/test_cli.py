@@ -51,6 +51,8 @@ BAD_INPUT = [
     (["bifurcation", "--rtol", "-1"], "--rtol"),
     (["bifurcation", "--omega0", "1,2"], "--omega0"),
     (["bifurcation", "--host-devices", "0"], "--host-devices"),
+    (["bifurcation", "--host-processes", "0"], "--host-processes"),
+    (["map", "--host-processes", "two"], "--host-processes"),
     (["bifurcation", "--param", "nonsense", "--values", "1,2"], "--param"),
     (["bifurcation", "--param", "mu"], "--values"),
     (["bifurcation", "--param", "mu", "--values", "0.1,-0.2"], "'mu'"),

@@ -257,7 +257,7 @@ QUOTES = [
     ),
     (
         "docs/bifurcation/README.md",
-        lambda: f"process per core, {_processes()['on']['ratio_numba_over_processes']:.2f}× faster, `processes.json` above",
+        lambda: f"process per core (`HostProcesses`), {_processes()['on']['ratio_numba_over_processes']:.2f}× faster, `processes.json` above",
     ),
     # per-step cost table (benchmarks/bench_step_parts.py)
     (

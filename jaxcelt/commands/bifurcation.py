@@ -81,6 +81,7 @@ def register(sub) -> None:
         help="CPU only: split the CPU into this many JAX devices and shard lanes over them (one XLA CPU "
         "computation uses about one core); 'auto' = number of CPU cores, 1 = off. Ignored on GPU",
     )
+    add_host_processes(p)
     p.add_argument(
         "--stop-on-invalid",
         action=argparse.BooleanOptionalAction,
@@ -205,6 +206,35 @@ def format_summary(ds, *, wall_seconds: float, out: Path, files: list[str], max_
     return "\n".join(lines)
 
 
+def add_host_processes(p) -> None:
+    p.add_argument(
+        "--host-processes",
+        default=None,
+        help="CPU only: run the lanes in this many worker processes, each pinned to a core with one JAX device "
+        "('auto' = number of CPU cores; default: off, one process with --host-devices). Steadier and faster "
+        "integrating every lane on; each worker compiles its own programs. Replaces --host-devices",
+    )
+
+
+def lane_devices(args):
+    """The sweep's ``devices``: a `jaxcelt.HostProcesses` with --host-processes (this process then keeps
+    one JAX device), else None (all local devices, as --host-devices split the CPU)."""
+    if args.host_processes is None:
+        _set_host_devices(args.host_devices)
+        return None
+    spec = args.host_processes
+    try:
+        n = spec if spec == "auto" else int(spec)
+    except ValueError:
+        n = 0
+    if n != "auto" and n < 1:
+        raise UsageError(f"argument --host-processes: must be an integer >= 1 or 'auto', got {spec!r}")
+    _set_host_devices("1")
+    from jaxcelt.ensemble import HostProcesses
+
+    return HostProcesses(n)
+
+
 def _set_host_devices(spec: str) -> int:
     """Ask JAX for ``spec`` CPU devices (before the backend starts); returns the count asked for."""
     import os
@@ -224,7 +254,7 @@ def _set_host_devices(spec: str) -> int:
     return n
 
 
-def run_settings(args, wall: float) -> dict:
+def run_settings(args, wall: float, devices=None) -> dict:
     """The settings and wall time of a sweep command (``bifurcation``, ``map``) for its summary.json."""
     import jax
 
@@ -238,7 +268,7 @@ def run_settings(args, wall: float) -> dict:
         "rtol": args.rtol,
         "atol": args.atol,
         "stop_on_invalid": bool(args.stop_on_invalid),
-        "devices": [str(d) for d in jax.local_devices()],
+        "devices": [str(d) for d in jax.local_devices()] if devices is None else repr(devices),
         "chunk_size": args.chunk_size,
         "width_per_device": args.width or DEFAULT_WIDTH,
         "wall_seconds_including_compile": round(wall, 2),
@@ -246,7 +276,7 @@ def run_settings(args, wall: float) -> dict:
 
 
 def run(args) -> int:
-    _set_host_devices(args.host_devices)
+    devices = lane_devices(args)
     import numpy as np
 
     import jaxcelt as jc
@@ -298,16 +328,19 @@ def run(args) -> int:
             width=args.width,
             stop_on_invalid=args.stop_on_invalid,
             sort_by_cost=True,
+            devices=devices,
             out=str(args.out),
             progress=True,
         )
     wall = time.perf_counter() - t0
+    if devices is not None:
+        devices.close()
     ds = open_sweep(args.out)
     summary = {
         "command": "jaxcelt bifurcation",
         "param": args.param,
         "n_values": int(values.size),
-        **run_settings(args, wall),
+        **run_settings(args, wall, devices),
         "lanes_failed": int(np.sum(np.isin(ds["status"].values, (1, 3)))),  # status 2 = stopped invalid
         "lanes_invalid": int(np.sum(ds["valid"].values == 0)),
         "regimes": _ranges(ds),

@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 
 from .args import UsageError, floats, nonnegative_int, override, overrides, positive_float, positive_int, value_range
-from .bifurcation import SWEEP_SOLVERS, _set_host_devices, run_settings
+from .bifurcation import SWEEP_SOLVERS, add_host_processes, lane_devices, run_settings
 
 
 def register(sub) -> None:
@@ -51,6 +51,7 @@ def register(sub) -> None:
     )
     p.add_argument("--host-devices", default="auto",
                    help="CPU only: split the CPU into this many JAX devices ('auto' = cores, 1 = off)")  # fmt: skip
+    add_host_processes(p)
     p.add_argument("--stop-on-invalid", action=argparse.BooleanOptionalAction, default=True,
                    help="end a lane at its first invalid state (lift-off or n3 <= 0): label 'invalid'")  # fmt: skip
     p.add_argument("--out", type=Path, default=Path("out/map"), help="output directory (resumable)")
@@ -101,7 +102,7 @@ def summarize(ds) -> dict:
 
 
 def run(args) -> int:
-    _set_host_devices(args.host_devices)
+    devices = lane_devices(args)
     import numpy as np
 
     import jaxcelt as jc
@@ -128,16 +129,18 @@ def run(args) -> int:
             params, x=x, y=y, y0=y0, transient_periods=args.transient, sample_periods=args.sample,
             lyapunov_periods=args.lyapunov, solver=make_solver(args.solver), rtol=args.rtol, atol=args.atol,
             max_steps=args.max_steps, chunk_size=args.chunk_size, width=args.width,
-            stop_on_invalid=args.stop_on_invalid, dtype=args.dtype, sort_by_cost=True, out=str(args.out),
-            progress=True,
+            stop_on_invalid=args.stop_on_invalid, dtype=args.dtype, sort_by_cost=True, devices=devices,
+            out=str(args.out), progress=True,
         )  # fmt: skip
     wall = time.perf_counter() - t0
+    if devices is not None:
+        devices.close()
     summary = {
         "command": "jaxcelt map",
         "x": {"name": x[0], "from": float(x[1][0]), "to": float(x[1][-1]), "n": int(x[1].size)},
         "y": {"name": y[0], "from": float(y[1][0]), "to": float(y[1][-1]), "n": int(y[1].size)},
         "set": args.set,
-        **run_settings(args, wall),
+        **run_settings(args, wall, devices),
         "dtype": args.dtype,
         "load_average_at_start": None if load is None else [round(v, 2) for v in load],
         **summarize(ds),

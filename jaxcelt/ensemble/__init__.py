@@ -6,6 +6,7 @@
 * `pool`: `run_pool`, lanes through a fixed number of refilled batch slots in one jitted
   while loop, with `PoolStats`;
 * `shard`: lanes over devices;
+* `processes`: `HostProcesses`, lanes over single-device worker processes, one per CPU core;
 * `stroboscopic`: `run_lanes`, one chunk of lanes sampled at the forcing's section times
   (`SweepConfig`), sharded over devices, with the optional Lyapunov stage.
 
@@ -25,6 +26,7 @@ from .pool import lane_outputs as lane_outputs
 from .pool import run_pool as run_pool
 from .pool import split_lane_args as split_lane_args
 from .pool import start_lanes as start_lanes
+from .processes import HostProcesses as HostProcesses
 from .shard import device_mesh as device_mesh
 from .shard import pad_lanes as pad_lanes
 from .shard import shard_lanes as shard_lanes

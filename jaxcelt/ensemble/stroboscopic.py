@@ -224,7 +224,15 @@ def run_lanes_with_stats(
 ) -> tuple[dict[str, np.ndarray], PoolStats]:
     """`run_lanes`, with the pool's statistics apart: (per-lane numpy arrays, `PoolStats` over
     all devices: the busiest device's iterations, the step slots paid by all, the width).
-    ``drain_factor``, ``min_drain_width``: the pool's drain schedule (`jaxcelt.ensemble.pool`)."""
+    ``drain_factor``, ``min_drain_width``: the pool's drain schedule (`jaxcelt.ensemble.pool`).
+    ``devices`` may be a `jaxcelt.ensemble.HostProcesses`: the lanes then run in its worker
+    processes, one per CPU core."""
+    from .processes import HostProcesses
+
+    if isinstance(devices, HostProcesses):
+        kw = dict(width=width, compile_only=compile_only, pilot_fraction=pilot_fraction)
+        kw.update(drain_factor=drain_factor, min_drain_width=min_drain_width)
+        return devices.run(pb, y0b, cfg, pad_to=pad_to, varying=tuple(varying), **kw)
     mesh = device_mesh(devices)
     L = int(np.shape(y0b)[0])
     ndev = 1 if mesh is None else mesh.devices.size
