@@ -98,7 +98,7 @@ def _run_until_chunks(cmd, out, n_min=1):
     t0 = time.time()
     while len(list((out / "chunks").glob("chunk_*.nc")) if (out / "chunks").exists() else []) < n_min:
         assert time.time() - t0 < 300 and p.poll() is None
-        time.sleep(0.2)
+        time.sleep(0.01)  # once compiled, a chunk of this test takes milliseconds: look often
     p.send_signal(signal.SIGKILL)
     p.wait()
     return sorted((out / "chunks").glob("chunk_*.nc"))
@@ -110,11 +110,13 @@ def test_killed_truncated_and_resumed(tmp_path):
     # the rerun prints one warning line, recomputes that chunk and writes the dataset of an
     # uninterrupted run (same machine and program: identical).
     out = tmp_path / "run"
-    cmd = [sys.executable, "-m", "jaxcelt", "bifurcation", "--omega", "12:19:8", "--transient", "3", "--sample", "4",
-           "--lyapunov", "0", "--max-steps", "4000", "--chunk-size", "2", "--orbits", "", "--no-figures",
+    # 16 chunks of one lane: the kill lands while chunks are still to be written (with 4 chunks of 2
+    # lanes, the last three were once all written between two looks at the directory)
+    cmd = [sys.executable, "-m", "jaxcelt", "bifurcation", "--omega", "12:19:16", "--transient", "3", "--sample", "4",
+           "--lyapunov", "0", "--max-steps", "4000", "--chunk-size", "1", "--orbits", "", "--no-figures",
            "--out", str(out)]  # fmt: skip
     files = _run_until_chunks(cmd, out)
-    assert not (out / "sweep.nc").exists() and len(files) < 4
+    assert not (out / "sweep.nc").exists() and len(files) < 16
     _damage(files[0], "truncate")
     rerun = subprocess.run(cmd, check=True, capture_output=True, text=True)
     warn = [s for s in rerun.stdout.splitlines() if "warning" in s]
