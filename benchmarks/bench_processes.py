@@ -33,21 +33,6 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 
 
-def _setup(n_freq: int, transient: int, sample: int, stop: bool, devices: int):
-    import jax
-
-    jax.config.update("jax_num_cpu_devices", devices)
-    import jaxcelt as jc
-    from jaxcelt.sweep import SweepConfig
-
-    p = jc.CeltParams.paper()
-    vals = np.linspace(10.0, 20.0, n_freq)
-    cfg = SweepConfig(
-        transient_periods=transient, sample_periods=sample, rtol=1e-8, atol=1e-10, stop_on_invalid=stop
-    )  # fmt: skip
-    return jc, p, vals, cfg
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n-freq", type=int, default=400)
@@ -59,8 +44,13 @@ def main() -> None:
     a = ap.parse_args()
     cores = len(os.sched_getaffinity(0))
     transient = a.periods - a.sample
-    jc, p, vals, _ = _setup(a.n_freq, transient, a.sample, True, cores)
     import jax
+
+    jax.config.update("jax_num_cpu_devices", cores)  # one device per core, before JAX starts
+    import jaxcelt as jc
+
+    p = jc.CeltParams.paper()
+    vals = np.linspace(10.0, 20.0, a.n_freq)
 
     sys.path.insert(0, str(HERE))
     import _numba_model as nm

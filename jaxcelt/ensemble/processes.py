@@ -23,7 +23,6 @@ own path).
 
 from __future__ import annotations
 
-import atexit
 import os
 import socket
 import subprocess
@@ -116,7 +115,9 @@ class HostProcesses:
     def __init__(self, n: int | str = "auto", *, cores: list[int] | None = None):
         if os.name != "posix":
             raise ValueError("HostProcesses needs a POSIX system (it passes sockets to its worker processes)")
-        avail = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else list(range(os.cpu_count() or 1))
+        avail = (
+            sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else list(range(os.cpu_count() or 1))
+        )
         if isinstance(n, str) and n == "auto":
             n = len(avail)
         if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
@@ -128,8 +129,7 @@ class HostProcesses:
         self.n = int(n)
         self.cores: list[int | None] = list(cores) if hasattr(os, "sched_setaffinity") else [None] * self.n
         self._workers: list[tuple[Any, Any]] = []
-        self._finalizer = weakref.finalize(self, _stop, self._workers)
-        atexit.register(self._finalizer)
+        self._finalizer = weakref.finalize(self, _stop, self._workers)  # also runs at interpreter exit
 
     def __repr__(self) -> str:
         return f"HostProcesses({self.n}, cores={self.cores})"
@@ -152,7 +152,9 @@ class HostProcesses:
                 env[k.upper()] = str(v)
         for core in self.cores:
             here, there = socket.socketpair()
-            wenv = dict(env, JAXCELT_WORKER_FD=str(there.fileno()), JAXCELT_WORKER_CORE="" if core is None else str(core))
+            wenv = dict(
+                env, JAXCELT_WORKER_FD=str(there.fileno()), JAXCELT_WORKER_CORE="" if core is None else str(core)
+            )
             proc = subprocess.Popen([sys.executable, "-c", _BOOT], env=wenv, pass_fds=(there.fileno(),))
             there.close()
             self._workers.append((Connection(here.detach()), proc))
@@ -161,15 +163,13 @@ class HostProcesses:
         self, pb: Any, y0b: Any, cfg: Any, *, pad_to: int | None, varying: tuple[str, ...], **kwargs: Any
     ) -> tuple[dict[str, np.ndarray], PoolStats]:
         """`jaxcelt.ensemble.run_lanes_with_stats` over the workers (lanes dealt round-robin)."""
-        from .stroboscopic import PARAM_NAMES
+        from .stroboscopic import varying_names
 
         pb = jax.tree_util.tree_map(np.asarray, pb)
         y0b = np.asarray(y0b, dtype=np.float64)
         L = int(y0b.shape[0])
         # what varies over the whole chunk, so that every worker (and every chunk) compiles one program
-        leaves = jax.tree_util.tree_flatten_with_path(pb)[0]
-        vary = {path[-1].name for path, x in leaves if np.any(x != x[:1])} & set(PARAM_NAMES)
-        varying = tuple(sorted(set(varying) | vary))
+        varying = tuple(sorted(set(varying) | varying_names(pb)))
         per = -(-max(L, pad_to or 0) // self.n)  # lanes per worker, padding included
         if not self._workers:
             self._start()

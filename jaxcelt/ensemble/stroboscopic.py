@@ -208,6 +208,12 @@ _lyap_chunk = {
 }
 
 
+def varying_names(pb: CeltParams) -> set[str]:
+    """Names of the parameters whose values differ between the lanes of ``pb`` (leading lane axis)."""
+    leaves = jax.tree_util.tree_flatten_with_path(pb)[0]
+    return {path[-1].name for path, x in leaves if np.any(np.asarray(x) != np.asarray(x)[:1])}
+
+
 def run_lanes_with_stats(
     pb: CeltParams,
     y0b: Array,
@@ -252,8 +258,8 @@ def run_lanes_with_stats(
     unknown = set(varying) - set(PARAM_NAMES)
     if unknown:
         raise ValueError(f"varying: unknown parameter name(s) {sorted(unknown)}")
-    path_leaves = jax.tree_util.tree_flatten_with_path(pb_np)[0]
-    vary = tuple(bool(path[-1].name in varying or np.any(x != x[:1])) for path, x in path_leaves)
+    names = set(varying) | varying_names(pb_np)
+    vary = tuple(path[-1].name in names for path, _ in jax.tree_util.tree_flatten_with_path(pb_np)[0])
     Lloc = Lp // ndev
     Wd = min(W, Lloc)
     # position i of the sharded arrays holds lane pos_lane[i]; device d holds positions
