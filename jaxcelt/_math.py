@@ -9,6 +9,14 @@ accurate to 2 ulp for |x| < 1e5 (tests against numpy over 2e5 random arguments; 
 loses accuracy only beyond |x| ~ 1e9, far past any angle or phase a run reaches). Derivatives
 are exact (custom JVP: d sin = cos dx, d cos = -sin dx). Other dtypes use ``jnp.sin``/``jnp.cos``.
 
+`log`: float64 natural logarithm, fdlibm's ``e_log.c`` (exponent split by bit operations,
+mantissa in [sqrt(1/2), sqrt(2)), a degree-14 polynomial in s = f / (2 + f)), < 1 ulp. XLA's CPU
+backend lowers float64 ``log`` to a scalar libm call (~1.6 ns per element in a vectorised loop on
+this project's CPU against ~0.45 ns here); the contact law takes four per evaluation. Special
+values as ``jnp.log``: log 0 = -inf, log of a negative number or NaN = NaN, log inf = inf;
+subnormal arguments are scaled into range first where the backend keeps them (XLA's CPU
+backend flushes them to zero, for ``jnp.log`` as here). Derivative d log = dx / x (custom JVP).
+
 `matvec3`, `cross3`: 3x3 matrix times 3-vector and the cross product as explicit multiply-adds.
 Under ``jax.vmap`` a product of a lane-constant matrix (the inertia tensor B, its adjugate) with
 a per-lane vector becomes an XLA ``dot``, which XLA's CPU backend runs as a library
@@ -30,7 +38,7 @@ import numpy as np
 
 from ._types import Array, ArrayLike
 
-__all__ = ["cross3", "matvec3", "sincos"]
+__all__ = ["cross3", "log", "matvec3", "sincos"]
 
 # Cephes sin.c: sin(z) = z + z^3 P(z^2), cos(z) = 1 - z^2/2 + z^4 Q(z^2) on |z| <= pi/4.
 _SIN = (
@@ -95,6 +103,61 @@ def sincos(x: ArrayLike) -> tuple[Array, Array]:
     if x.dtype == jnp.float64:
         return _sincos64(x)
     return jnp.sin(x), jnp.cos(x)
+
+
+# fdlibm e_log.c: log(1 + f) = 2s + s R(s^2), s = f / (2 + f), |s| <= 0.1716
+_LG = (
+    6.666666666666735130e-01,
+    3.999999999940941908e-01,
+    2.857142874366239149e-01,
+    2.222219843214978396e-01,
+    1.818357216161805012e-01,
+    1.531383769920937332e-01,
+    1.479819860511658591e-01,
+)
+_LN2_HI, _LN2_LO = 6.93147180369123816490e-01, 1.90821492927058770002e-10
+_SQRT_HALF_BITS = 0x3FE6A09E667F3BCD  # bits of sqrt(1/2): mantissas are mapped to [sqrt(1/2), sqrt(2))
+_EXP_ONE = 0x3FF0000000000000
+_TINY = 2.2250738585072014e-308  # smallest normal float64
+
+
+def _log_f64(x: Array) -> Array:
+    sub = x < _TINY
+    xs = jnp.where(sub, x * 18014398509481984.0, x)  # 2**54: subnormals into the normal range
+    bits = jax.lax.bitcast_convert_type(xs, jnp.int64) + (_EXP_ONE - _SQRT_HALF_BITS)
+    k = (bits >> 52) - 1023 - jnp.where(sub, 54, 0)
+    m = jax.lax.bitcast_convert_type((bits & 0x000FFFFFFFFFFFFF) + _SQRT_HALF_BITS, jnp.float64)
+    f = m - 1.0
+    s = f / (2.0 + f)
+    z = s * s
+    w = z * z
+    r = z * (_LG[0] + w * (_LG[2] + w * (_LG[4] + w * _LG[6]))) + w * (_LG[1] + w * (_LG[3] + w * _LG[5]))
+    hfsq = 0.5 * f * f
+    dk = k.astype(jnp.float64)
+    out = dk * _LN2_HI - ((hfsq - (s * (hfsq + r) + dk * _LN2_LO)) - f)
+    # special values as jnp.log: 0 -> -inf, negative or NaN -> NaN, inf -> inf
+    out = jnp.where(x == 0, -jnp.inf, out)
+    out = jnp.where((x < 0) | jnp.isnan(x), jnp.nan, out)
+    return jnp.where(x == jnp.inf, jnp.inf, out)
+
+
+@jax.custom_jvp
+def _log64(x: Array) -> Array:
+    return _log_f64(x)
+
+
+@_log64.defjvp
+def _log64_jvp(primals, tangents):
+    (x,), (dx,) = primals, tangents
+    return _log64(x), dx / x
+
+
+def log(x: ArrayLike) -> Array:
+    """Natural logarithm, elementwise; fast vectorised float64 path (see the module docstring)."""
+    x = jnp.asarray(x)
+    if x.dtype == jnp.float64:
+        return _log64(x)
+    return jnp.log(x)
 
 
 def matvec3(m: ArrayLike, x: Array) -> Array:

@@ -11,6 +11,7 @@ processes are `jaxcelt.sweep`'s business.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Sequence
 from typing import Any
@@ -21,7 +22,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .. import _config  # noqa: F401
-from .._compile_options import compiler_options
+from .._compile_options import compiler_options, pool_compiler_options
 from .._executable_cache import compile_later, gc_paused, start_deferred
 from .._types import Array
 from ..contact import get_contact_law
@@ -283,7 +284,7 @@ def run_lanes_with_stats(
                  opaque_true, (int(drain_factor), int(min_drain_width)))  # fmt: skip
     with gc_paused():
         pool_lowered = _pool_chunk.lower(*pool_args)
-    pool_compiled = compile_later(pool_lowered.compile)
+    pool_compiled = compile_later(functools.partial(pool_lowered.compile, pool_compiler_options(platform)))
     lyap_compiled = None
     if cfg.lyapunov_periods > 0 and not compile_only:
         example = (jax.tree_util.tree_map(lambda x: x[:1].repeat(G, 0), pb_np), np.zeros((G, 13)), np.zeros(G))
