@@ -3,7 +3,9 @@ Tsit5 step with `MonitoredSolver` (what `simulate` runs: 6 RHS + RK bookkeeping 
 extra normal-force evaluation), the pool's fused step (`jaxcelt.ensemble.FusedERKStepper`: 6 RHS,
 monitor from the FSAL evaluation, PID + section clipping) with and without its stage-input
 kernel boundaries, and the full pool iteration is `bench_pool_width.py`'s business. Each part
-is vmapped over the lanes inside one jitted loop (no dispatch), best of 5, one JAX device.
+is vmapped over the lanes inside one jitted loop (no dispatch), best of 5, one JAX device,
+compiled with XLA's default options (256-bit vectors; the pool's own program is compiled with
+512-bit vectors on a CPU, whose effect `roofline.py` and `vector_width.py` measure).
 `step_parts` is also what ``bench_sweep.py`` uses for its per-evaluation costs.
 
     .venv/bin/python benchmarks/bench_step_parts.py [--width 32] [--samples 100] [--out docs/bifurcation]

@@ -108,7 +108,7 @@ def main():
 
     # the lane pool's compiler options (512-bit vectors on a CPU) and XLA's defaults (256-bit)
     us_default = us_per_lane_eval(rhs_roofline_default, None)
-    us_pool = us_per_lane_eval(rhs_roofline, pool_compiler_options(jax.default_backend()))
+    us_pool = us_per_lane_eval(rhs_roofline, pool_compiler_options(jax.default_backend(), W))
 
     # scalar library calls left in the optimised IR of the loop
     # LLVM's x86 back end turns sqrt/floor/fabs/min/max intrinsics into vector instructions but
@@ -140,7 +140,7 @@ def main():
         },  # fmt: skip
         "flops_per_transcendental_assumed": FLOPS_PER_TRANSCENDENTAL,
         "effective_flops_per_lane_eval": eff_flops,
-        "compiler_options": pool_compiler_options(jax.default_backend()),
+        "compiler_options": pool_compiler_options(jax.default_backend(), W),
         "measured_us_per_lane_eval_one_core": us_pool,
         "measured_us_per_lane_eval_one_core_xla_defaults": us_default,
         "ideal_us_per_lane_eval_one_core": ideal_us,

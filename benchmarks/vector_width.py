@@ -6,7 +6,8 @@ on, with the pool's program compiled two ways:
 
 * ``256``: XLA's CPU default (LLVM's preferred vector width, 256 bits: 4 doubles per vector);
 * ``512``: ``xla_cpu_prefer_vector_width=512``, what ``jaxcelt`` compiles the pool with on a CPU
-  (``jaxcelt._compile_options.pool_compiler_options``).
+  (``jaxcelt._compile_options.pool_compiler_options``, for pools of at least 64 slots per device;
+  the sweep here has 96).
 
 Each variant runs in a fresh process (compilation timed apart, then ``--runs`` timed runs); the
 variants alternate, ``--reps`` processes each, and the medians are reported with their ratio. The

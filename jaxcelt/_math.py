@@ -11,11 +11,12 @@ are exact (custom JVP: d sin = cos dx, d cos = -sin dx). Other dtypes use ``jnp.
 
 `log`: float64 natural logarithm, fdlibm's ``e_log.c`` (exponent split by bit operations,
 mantissa in [sqrt(1/2), sqrt(2)), a degree-14 polynomial in s = f / (2 + f)), < 1 ulp. XLA's CPU
-backend lowers float64 ``log`` to a scalar libm call (~1.6 ns per element in a vectorised loop on
-this project's CPU against ~0.45 ns here); the contact law takes four per evaluation. Special
-values as ``jnp.log``: log 0 = -inf, log of a negative number or NaN = NaN, log inf = inf;
-subnormal arguments are scaled into range first where the backend keeps them (XLA's CPU
-backend flushes them to zero, for ``jnp.log`` as here). Derivative d log = dx / x (custom JVP).
+backend lowers float64 ``log`` to one scalar libm call per element; the contact law takes four
+per evaluation, and with this version the right-hand side calls no libm function at all
+(``benchmarks/roofline.py`` lists the calls left in the compiled code). Special values as
+``jnp.log``: log 0 = -inf, log of a negative number or NaN = NaN, log inf = inf; subnormal
+arguments are scaled into range first where the backend keeps them (XLA's CPU backend flushes
+them to zero, for ``jnp.log`` as here). Derivative d log = dx / x (custom JVP).
 
 `matvec3`, `cross3`: 3x3 matrix times 3-vector and the cross product as explicit multiply-adds.
 Under ``jax.vmap`` a product of a lane-constant matrix (the inertia tensor B, its adjugate) with

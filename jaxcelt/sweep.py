@@ -52,14 +52,14 @@ Execution model
   the first JAX operation: ``jax.config.update("jax_num_cpu_devices", K)`` (or
   ``XLA_FLAGS=--xla_force_host_platform_device_count=K``); the CLI does this by default
   (``--host-devices auto`` = number of cores). Measured on 2 cores: 400 x 300 periods in
-  4.45 s on 2 devices vs 9.2 s on 1 (stopping at invalid states, compile apart;
+  3.69 s on 2 devices vs 7.9 s on 1 (stopping at invalid states, compile apart;
   docs/bifurcation/bench_sweep_400x300.json). Results agree with the
   1-device run to ~1e-11 over a few periods (tests), not bitwise (a different compiled
   program): over hundreds of periods chaotic lanes diverge from that seed like any other.
   The devices of one process share XLA's CPU thread pool; ``devices=HostProcesses("auto")``
   (`jaxcelt.ensemble.processes`; ``--host-processes auto``) runs the lanes in one pinned
-  single-device worker process per core instead (steadier and faster integrating every lane
-  on; docs/bifurcation/README.md).
+  single-device worker process per core instead (no shared pool; how the two compare is
+  measured in docs/bifurcation/processes.json).
 
 Multi-host (several processes or machines, each with local devices)
 -------------------------------------------------------------------

@@ -274,6 +274,27 @@ def test_pool_drain_compaction_keeps_lanes(paper_params):
     assert_same_lanes(wide, narrow)
 
 
+def test_wide_vector_pool_keeps_lanes(paper_params):
+    # A pool of >= WIDE_VECTORS_MIN_SLOTS slots per device is compiled for 512-bit vectors on a CPU
+    # (`jaxcelt._compile_options.pool_compiler_options`), a narrower one with XLA's defaults: two
+    # compiled programs that may round differently (on a CPU without AVX-512 they are the same).
+    # Lanes must not depend on it: same step counts and statuses, samples within SAMPLE_ATOL.
+    from jaxcelt._compile_options import WIDE_VECTORS_MIN_SLOTS, pool_compiler_options
+    from jaxcelt.sweep import SweepConfig, run_lanes
+
+    W = WIDE_VECTORS_MIN_SLOTS
+    assert pool_compiler_options("cpu", W) == {"xla_cpu_prefer_vector_width": 512}
+    assert pool_compiler_options("cpu", W // 4) is None and pool_compiler_options("gpu", W) is None
+    vals = np.linspace(12.0, 19.0, W)
+    y0 = np.tile(np.asarray(jc.initial_state(paper_params)), (len(vals), 1))
+    pb = lanes_params(paper_params, "omega_pi", vals)
+    cfg = SweepConfig(transient_periods=0, sample_periods=2, max_steps=4000)
+    one = jax.local_devices()[:1]
+    wide = run_lanes(pb, y0, cfg, width=W, devices=one)
+    narrow = run_lanes(pb, y0, cfg, width=W // 4, devices=one)
+    assert_same_lanes(wide, narrow)
+
+
 def test_narrow_pool_inner_loop_keeps_lanes(paper_params):
     # A pool of at most SEQUENTIAL_WIDTH slots steps in an inner loop until a lane reaches a
     # section time, finishes or pauses, and its stepper sees only each lane's next two section

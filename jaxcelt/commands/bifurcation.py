@@ -211,8 +211,8 @@ def add_host_processes(p) -> None:
         "--host-processes",
         default=None,
         help="CPU only: run the lanes in this many worker processes, each pinned to a core with one JAX device "
-        "('auto' = number of CPU cores; default: off, one process with --host-devices). Steadier and faster "
-        "integrating every lane on; each worker compiles its own programs. Replaces --host-devices",
+        "('auto' = number of CPU cores; default: off, one process with --host-devices). The workers share no "
+        "thread pool; each compiles its own programs. Replaces --host-devices",
     )
 
 

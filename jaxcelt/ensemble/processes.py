@@ -2,11 +2,13 @@
 
 In one process, XLA's CPU runtime runs the programs of all local devices on one shared thread
 pool (one thread per device), and hands a program's ready kernels to that pool, where the
-threads take them from each other's queues. With a JAX device per core this costs time and
-makes it vary: integrating every lane on, the 400 x 300 sweep took about three quarters of the
-time in 2 pinned single-device processes that it took in one process with 2 devices, and did so
-steadily; stopping lanes at invalid states, about as long (``benchmarks/bench_processes.py`` ->
-docs/bifurcation/processes.json).
+threads take them from each other's queues. One single-device process per core, pinned to
+it, shares no pool. What that buys depends on the program: on this project's 2-core CPU, with
+the pool compiled for 256-bit vectors, the 400 x 300 sweep integrating every lane on took about
+three quarters of the one-process time in 2 pinned processes, and varied less; with the
+512-bit program the library compiles now, it took 19.4 s in the processes against
+18.1 s in one process, and stopping lanes at invalid states 3.57 s against 3.69 s
+(``benchmarks/bench_processes.py`` -> docs/bifurcation/processes.json).
 
 `HostProcesses` is accepted wherever a sweep takes ``devices`` (`jaxcelt.sweep.sweep`,
 ``bifurcation``, ``parameter_map``, `jaxcelt.sweep.run_lanes`): each chunk's lanes are dealt

@@ -284,7 +284,7 @@ def run_lanes_with_stats(
                  opaque_true, (int(drain_factor), int(min_drain_width)))  # fmt: skip
     with gc_paused():
         pool_lowered = _pool_chunk.lower(*pool_args)
-    pool_compiled = compile_later(functools.partial(pool_lowered.compile, pool_compiler_options(platform)))
+    pool_compiled = compile_later(functools.partial(pool_lowered.compile, pool_compiler_options(platform, Wd)))
     lyap_compiled = None
     if cfg.lyapunov_periods > 0 and not compile_only:
         example = (jax.tree_util.tree_map(lambda x: x[:1].repeat(G, 0), pb_np), np.zeros((G, 13)), np.zeros(G))
