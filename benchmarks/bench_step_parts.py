@@ -4,8 +4,9 @@ extra normal-force evaluation), the pool's fused step (`jaxcelt.ensemble.FusedER
 monitor from the FSAL evaluation, PID + section clipping) with and without its stage-input
 kernel boundaries, and the full pool iteration is `bench_pool_width.py`'s business. Each part
 is vmapped over the lanes inside one jitted loop (no dispatch), best of 5, one JAX device,
-compiled with XLA's default options (256-bit vectors; the pool's own program is compiled with
-512-bit vectors on a CPU, whose effect `roofline.py` and `vector_width.py` measure).
+compiled with XLA's default options and the default contact law, as a narrow pool runs (a wide
+pool's program is compiled with 512-bit vectors on a CPU and runs the law's ``wide_batch`` form,
+whose effect `roofline.py` and `vector_width.py` measure).
 `step_parts` is also what ``bench_sweep.py`` uses for its per-evaluation costs.
 
     .venv/bin/python benchmarks/bench_step_parts.py [--width 32] [--samples 100] [--out docs/bifurcation]

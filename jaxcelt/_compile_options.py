@@ -9,7 +9,9 @@ AVX-512 the option changes nothing (LLVM caps the width at what the CPU has; che
 ``--xla_cpu_max_isa=AVX2``: the same program, the same steps). Wider vectors cost compilation
 time, and a narrow pool gains nothing from them (the main job's pool of 30 slots per device ran
 no faster with them and compiled longer), so only pools of at least `WIDE_VECTORS_MIN_SLOTS`
-slots per device get them (the 400 x 300 sweep has 96). The Lyapunov stage and the fit,
+slots per device get them (the 400 x 300 sweep has 96), together with the contact law's
+``wide_batch`` form (`jaxcelt.contact.AbstractContactLaw.wide_batch`: the vectorised logarithm,
+which also costs compilation; `is_wide_pool`). The Lyapunov stage and the fit,
 compiled with the loop emitters below, do not gain from them and go without.
 
 The programs that hold a differentiated ODE solve:
@@ -38,6 +40,12 @@ def compiler_options(platform: str) -> dict | None:
     return dict(LOOP_EMITTERS) if platform == "cpu" else None
 
 
+def is_wide_pool(platform: str, slots: int) -> bool:
+    """Whether a lane pool of ``slots`` slots per device on ``platform`` gets wide vectors (and its
+    contact law's `wide_batch` form: the vectorised logarithm, which costs compilation)."""
+    return platform == "cpu" and slots >= WIDE_VECTORS_MIN_SLOTS
+
+
 def pool_compiler_options(platform: str, slots: int) -> dict | None:
     """The options of the lane pool's program compiled for ``platform`` with ``slots`` slots per device."""
-    return dict(WIDE_VECTORS) if platform == "cpu" and slots >= WIDE_VECTORS_MIN_SLOTS else None
+    return dict(WIDE_VECTORS) if is_wide_pool(platform, slots) else None

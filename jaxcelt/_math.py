@@ -11,9 +11,11 @@ are exact (custom JVP: d sin = cos dx, d cos = -sin dx). Other dtypes use ``jnp.
 
 `log`: float64 natural logarithm, fdlibm's ``e_log.c`` (exponent split by bit operations,
 mantissa in [sqrt(1/2), sqrt(2)), a degree-14 polynomial in s = f / (2 + f)), < 1 ulp. XLA's CPU
-backend lowers float64 ``log`` to one scalar libm call per element; the contact law takes four
-per evaluation, and with this version the right-hand side calls no libm function at all
-(``benchmarks/roofline.py`` lists the calls left in the compiled code). Special values as
+backend lowers float64 ``log`` to one scalar libm call per element; the Pade laws take four per
+evaluation, and in their ``wide_batch`` form (``vector_log=True``, what the lane pool's wide pools
+run) they use this version, so that the right-hand side calls no libm function at all
+(``benchmarks/roofline.py`` lists the calls left in the compiled code). Its polynomial is inlined
+at every use, which lengthens XLA's compilation of many-stage programs. Special values as
 ``jnp.log``: log 0 = -inf, log of a negative number or NaN = NaN, log inf = inf; subnormal
 arguments are scaled into range first where the backend keeps them (XLA's CPU backend flushes
 them to zero, for ``jnp.log`` as here). Derivative d log = dx / x (custom JVP).

@@ -17,6 +17,8 @@ Discrete options (rolling resistance on/off, quadrature order) are static fields
 from __future__ import annotations
 
 import abc
+import dataclasses
+from collections.abc import Callable
 from typing import NamedTuple
 
 import equinox as eqx
@@ -81,11 +83,11 @@ def safe_abs_pow(x: Array, p: Array) -> Array:
     return jnp.where(pos, jnp.where(pos, ax, 1.0) ** p, 0.0)
 
 
-def _safe_log_abs(x: Array) -> tuple[Array, Array]:
+def _safe_log_abs(x: Array, log: Callable[[Array], Array] = jnp.log) -> tuple[Array, Array]:
     """(log|x| where x != 0 else 0, x != 0): with `_exp_or_0`, |x|**p = exp(p log|x|) with
     the value and both gradients of `safe_abs_pow` at x = 0 (the masked base, as there)."""
     pos = jnp.abs(x) > 0
-    return _math.log(jnp.where(pos, jnp.abs(x), 1.0)), pos
+    return log(jnp.where(pos, jnp.abs(x), 1.0)), pos
 
 
 def _exp_or_0(a: Array, pos: Array) -> Array:
@@ -100,6 +102,11 @@ class AbstractContactLaw(eqx.Module):
     """
 
     rolling_resistance: eqx.AbstractVar[bool]
+
+    def wide_batch(self) -> AbstractContactLaw:
+        """The same law, computed the way that pays in wide vmapped batches on a CPU (the lane
+        pool's wide pools use it); by default the law itself. Values agree to rounding."""
+        return self
 
     @abc.abstractmethod
     def friction(
@@ -149,17 +156,33 @@ class GeneralisedPade(AbstractContactLaw):
     """
 
     rolling_resistance: bool = eqx.field(default=True, static=True)
+    vector_log: bool = eqx.field(default=False, static=True)
+    """float64 logarithms of the denominators by `jaxcelt._math.log` (vector arithmetic) instead of
+    ``jnp.log`` (XLA's CPU backend: one scalar libm call per element); see `wide_batch`."""
+
+    def wide_batch(self) -> GeneralisedPade:
+        """With ``vector_log``: faster in wide batches on a CPU, but its inlined polynomial makes
+        XLA's compilation of a many-stage program about a second longer (docs/bifurcation/README.md)."""
+        return dataclasses.replace(self, vector_log=True)
 
     def friction(self, kin, d_c, d_s, p):
-        return pade_friction(kin, d_c, d_s, p, p.m_Ts, p.m_Ms)
+        log = _math.log if self.vector_log else jnp.log
+        return pade_friction(kin, d_c, d_s, p, p.m_Ts, p.m_Ms, log=log)
 
 
 def pade_friction(
-    kin: ContactKinematics, d_c: Scalar, d_s: Scalar, p: CeltParams, m_T: ScalarLike, m_M: ScalarLike
+    kin: ContactKinematics,
+    d_c: Scalar,
+    d_s: Scalar,
+    p: CeltParams,
+    m_T: ScalarLike,
+    m_M: ScalarLike,
+    log: Callable[[Array], Array] = jnp.log,
 ) -> tuple[Scalar, Scalar, Scalar]:
     """Eq. (13) with exponents (m_T, m_M) given explicitly (the shared kernel of the Pade laws).
 
-    Non-dimensional (T_sx, T_sy, M_s); inputs in 1/s (MODEL.md section 7).
+    Non-dimensional (T_sx, T_sy, M_s); inputs in 1/s (MODEL.md section 7). ``log``: the natural
+    logarithm used for the denominators' powers (``jnp.log`` or `jaxcelt._math.log`).
     """
     vsx, vsy, w = kin.vsx, kin.vsy, kin.omega_s
     _, E, G, H = contact_integrals(p.b)
@@ -168,10 +191,10 @@ def pade_friction(
     # D_T = (V^(3 m_T) + b_Ts^m_T |w|^(3 m_T))^(1/m_T), D_M likewise, with powers written as
     # exp(a log x) sharing log V^2 and log|w|: 4 logs and 6 exps instead of 6 pows (XLA's CPU
     # pow costs ~14 ns per element against ~2 / ~4.4 ns for exp / log; ~15 % of the RHS)
-    lV2 = _math.log(V2)
-    lw, w_pos = _safe_log_abs(w)
-    D_T = jnp.exp(_math.log(jnp.exp(1.5 * m_T * lV2) + p.b_Ts**m_T * _exp_or_0(3 * m_T * lw, w_pos)) / m_T)
-    D_M = jnp.exp(_math.log(p.b_Ms**m_M * _exp_or_0(3 * m_M * lw, w_pos) + jnp.exp(1.5 * m_M * lV2)) / m_M)
+    lV2 = log(V2)
+    lw, w_pos = _safe_log_abs(w, log)
+    D_T = jnp.exp(log(jnp.exp(1.5 * m_T * lV2) + p.b_Ts**m_T * _exp_or_0(3 * m_T * lw, w_pos)) / m_T)
+    D_M = jnp.exp(log(p.b_Ms**m_M * _exp_or_0(3 * m_M * lw, w_pos) + jnp.exp(1.5 * m_M * lV2)) / m_M)
     # Printed grouping: b_Ts multiplies the pi S3 terms that sit inside its bracket.
     # The derivative-exact grouping takes them out; blend by the 0/1 switch so that the
     # reading stays a float leaf (vmappable over readings).
@@ -200,9 +223,15 @@ class Pade(AbstractContactLaw):
     """
 
     rolling_resistance: bool = eqx.field(default=True, static=True)
+    vector_log: bool = eqx.field(default=False, static=True)
+    """as `GeneralisedPade.vector_log`"""
+
+    def wide_batch(self) -> Pade:
+        """With ``vector_log`` (as `GeneralisedPade.wide_batch`)."""
+        return dataclasses.replace(self, vector_log=True)
 
     def friction(self, kin, d_c, d_s, p):
-        return pade_friction(kin, d_c, d_s, p, 1.0, 1.0)
+        return pade_friction(kin, d_c, d_s, p, 1.0, 1.0, log=_math.log if self.vector_log else jnp.log)
 
 
 class CoulombSpin(AbstractContactLaw):

@@ -106,3 +106,31 @@ def test_pade_friction_kernel_matches_regression():
     p = jc.CeltParams.paper()
     T = np.array(pade_friction(kin, -0.2647549185, 0.4120477463, p, p.m_Ts, p.m_Ms))
     np.testing.assert_allclose(T, [-0.9454266651, 0.3268436384, 3.5416791537e-4], rtol=1e-8)
+
+
+@pytest.mark.parametrize("name", APPROX)
+def test_wide_batch_form_agrees(name):
+    # `wide_batch` (the lane pool's wide pools) computes the Pade laws' logarithms by
+    # `jaxcelt._math.log` (<= 1 ulp from libm's), the others are unchanged. Friction values and
+    # their gradients agree to rounding: rtol 1e-13 (a few ulp through exp(log(.) / m) chains).
+    law = jc.get_contact_law(name)
+    wide = law.wide_batch()
+    assert law_name(wide) == name and wide.rolling_resistance == law.rolling_resistance
+    rng = np.random.default_rng(1)
+    vx, vy, w = rng.normal(size=(3, 200)) * np.array([[1.0], [1.0], [3.0]])
+    p = _p()
+
+    def fr(law_, vx, vy, w):
+        kin = ContactKinematics(vx, vy, w, vx, vy)
+        return jnp.stack(law_.friction(kin, 0.05, -0.02, p))
+
+    a = jax.vmap(lambda *x: fr(law, *x))(vx, vy, w)
+    b = jax.vmap(lambda *x: fr(wide, *x))(vx, vy, w)
+    np.testing.assert_allclose(np.asarray(b), np.asarray(a), rtol=1e-13, atol=1e-15)
+    ga = jax.vmap(jax.grad(lambda *x: fr(law, *x).sum(), argnums=(0, 1, 2)))(vx, vy, w)
+    gb = jax.vmap(jax.grad(lambda *x: fr(wide, *x).sum(), argnums=(0, 1, 2)))(vx, vy, w)
+    np.testing.assert_allclose(np.asarray(gb), np.asarray(ga), rtol=1e-12, atol=1e-14)
+    if name in ("generalised_pade", "pade"):
+        assert wide.vector_log and not law.vector_log
+    else:
+        assert wide is law

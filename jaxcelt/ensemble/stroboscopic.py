@@ -22,7 +22,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .. import _config  # noqa: F401
-from .._compile_options import compiler_options, pool_compiler_options
+from .._compile_options import compiler_options, is_wide_pool, pool_compiler_options
 from .._executable_cache import compile_later, gc_paused, start_deferred
 from .._types import Array
 from ..contact import get_contact_law
@@ -275,6 +275,8 @@ def run_lanes_with_stats(
     # conditional costs a device-to-host sync per stage, so none there
     platform = (list(devices)[0] if devices else jax.local_devices()[0]).platform
     opaque_true = jnp.asarray(True) if platform == "cpu" else None
+    if is_wide_pool(platform, Wd):  # the contact law's form for wide batches (vectorised logarithm)
+        nocfg = dataclasses.replace(nocfg, contact_law=get_contact_law(nocfg.contact_law).wide_batch())
     G = Wd * ndev  # the Lyapunov stage's chunk: the pool's width (a chunk of few lanes solves no padding copies)
     lyap_fn = _lyap_chunk["cpu" if platform == "cpu" else "other"]
     # The pool's program and the Lyapunov stage's are traced here, one after the other, and
