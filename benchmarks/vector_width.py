@@ -9,11 +9,15 @@ on, with the pool's program compiled two ways:
   (``jaxcelt._compile_options.pool_compiler_options``, for pools of at least 64 slots per device;
   the sweep here has 96).
 
+Both variants run the contact law's ``wide_batch`` form (the pool's choice for wide pools); only the
+vector width differs. The library gives 512-bit vectors only to pools of at least 64 slots per
+device, so with fewer than 64 lanes per core the two variants are the same program.
+
 Each variant runs in a fresh process (compilation timed apart, then ``--runs`` timed runs); the
 variants alternate, ``--reps`` processes each, and the medians are reported with their ratio. The
 two programs round differently, so a lane that has left the model's validity (chaotic) may take other
 steps over hundreds of periods: each variant's total steps and status counts are recorded.
-The CPU's model name and whether it has AVX-512 are recorded from ``/proc/cpuinfo``.
+The CPU's model name and vector ISA are recorded from ``/proc/cpuinfo`` (``roofline.cpu_facts``).
 
     .venv/bin/python benchmarks/vector_width.py --out docs/bifurcation   # -> vector_width.json
 """
@@ -29,6 +33,7 @@ import sys
 import time
 from pathlib import Path
 
+HERE = Path(__file__).resolve().parent
 VARIANTS = ("256", "512")
 
 
@@ -68,21 +73,6 @@ def child(variant: str, mode: str, n_freq: int, periods: int, sample: int, runs:
     )  # fmt: skip
 
 
-def cpu_info() -> dict:
-    info = {"model": "unknown", "avx512f": None}
-    try:
-        text = Path("/proc/cpuinfo").read_text()
-    except OSError:
-        return info
-    for line in text.splitlines():
-        if line.startswith("model name"):
-            info["model"] = line.split(":", 1)[1].strip()
-        if line.startswith("flags"):
-            info["avx512f"] = "avx512f" in line.split()
-            break
-    return info
-
-
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n-freq", type=int, default=400)
@@ -98,12 +88,15 @@ def main() -> int:
         row = child(*a.child, a.n_freq, a.periods, a.sample, a.runs)
         print("ROW " + json.dumps(row), flush=True)
         return 0
+    sys.path.insert(0, str(HERE))
+    from roofline import cpu_facts
+
     from jaxcelt.versions import versions
 
     V = versions()
     print(" ".join(f"{k}={v}" for k, v in V.items()), flush=True)
     res: dict = dict(
-        versions=V, cpu=cpu_info(), cores=len(os.sched_getaffinity(0)), load_average_at_start=os.getloadavg(),
+        versions=V, cpu=cpu_facts(), cores=len(os.sched_getaffinity(0)), load_average_at_start=os.getloadavg(),
         config=dict(n_freq=a.n_freq, periods=a.periods, sample=a.sample, rtol=1e-8, atol=1e-10, solver="Tsit5"),
         rows=[], summary={},
     )  # fmt: skip
