@@ -90,6 +90,11 @@ def _safe_log_abs(x: Array, log: Callable[[Array], Array] = jnp.log) -> tuple[Ar
     return log(jnp.where(pos, jnp.abs(x), 1.0)), pos
 
 
+def _denominator_log(vector_log: bool) -> Callable[[Array], Array]:
+    """The Pade laws' logarithm: `jaxcelt._math.log` in their ``wide_batch`` form, else ``jnp.log``."""
+    return _math.log if vector_log else jnp.log
+
+
 def _exp_or_0(a: Array, pos: Array) -> Array:
     return jnp.where(pos, jnp.exp(a), 0.0)
 
@@ -166,8 +171,7 @@ class GeneralisedPade(AbstractContactLaw):
         return dataclasses.replace(self, vector_log=True)
 
     def friction(self, kin, d_c, d_s, p):
-        log = _math.log if self.vector_log else jnp.log
-        return pade_friction(kin, d_c, d_s, p, p.m_Ts, p.m_Ms, log=log)
+        return pade_friction(kin, d_c, d_s, p, p.m_Ts, p.m_Ms, log=_denominator_log(self.vector_log))
 
 
 def pade_friction(
@@ -231,7 +235,7 @@ class Pade(AbstractContactLaw):
         return dataclasses.replace(self, vector_log=True)
 
     def friction(self, kin, d_c, d_s, p):
-        return pade_friction(kin, d_c, d_s, p, 1.0, 1.0, log=_math.log if self.vector_log else jnp.log)
+        return pade_friction(kin, d_c, d_s, p, 1.0, 1.0, log=_denominator_log(self.vector_log))
 
 
 class CoulombSpin(AbstractContactLaw):
