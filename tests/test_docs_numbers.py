@@ -487,3 +487,43 @@ def test_fit_benchmark_table_from_json():
         r = ms[mode]
         assert f"{mode}: compile {r['compile_s']:.1f} s, run {r['run_s']:.1f} s" in flat, mode
     assert f"{ms['vmapped']['n_at_best']} of {ms['vmapped']['n_starts']} starts" in flat
+
+
+def test_gpu_projection_from_step_census_json():
+    """The projection of the 400 x 400 map in the engine's GPU section against
+    docs/performance/map_step_census.json (benchmarks/map_step_census.py), and the bounds against the step
+    counts and the GPU rates they are made of (1e-3 relative: the JSON rounds to 0.1 s)."""
+    text = " ".join(_text("docs/bifurcation/README.md").split())
+    d = _json("docs/performance/map_step_census.json")
+    p, q, r, sb = d["projection"], d["projection_without_stiff_lanes"], d["stiff_rerun"], d["stiff_box"]
+    rate = d["rates"]["widest_pool_slot_steps_per_s"]
+    gpu = [x for x in _json("docs/performance/gpu_map.json")["runs"] if "run_s" in x and x["width"] == 160000]
+    assert rate == max(round(x["lanes"] * x["steps_max"] / x["run_s"]) for x in gpu if x["dtype"] == "float64")
+    assert p["work_bound_s"] == pytest.approx(d["steps_mean"] * 160000 / rate, rel=1e-3)
+    assert p["latency_bound_s"] == pytest.approx(
+        d["steps_max"] * d["rates"]["narrowest_pool_us_per_iteration"] * 1e-6, rel=1e-3
+    )
+
+    def sp(n):
+        return f"{n:,}".replace(",", " ")
+
+    quotes = [
+        f"{d['grid'][0]} × {d['grid'][1]} grid of the same box ({d['periods']} periods",
+        f"{d['wall_s_including_compile']:.1f} s on the 2-core CPU",
+        f"{sp(round(d['steps_mean']))} steps on average (median {sp(round(d['steps_quantiles']['q50']))})",
+        f"at least {p['work_bound_s']:.1f} s, even with every slot busy",
+        f"{p['slot_step_rate_needed_x']:.2f}× the measured slot-step rate",
+        f"({d['stiff_lanes_at_max_steps']} of {d['lanes']})",
+        f"least {p['latency_bound_s']:.1f} s.",
+        f"{d['stiff_lanes']} of {d['lanes']} lanes, ω_π ≤ {sb['omega_pi'][1]:.1f} rad/s",
+        f"q_π ≤ {sb['q_pi'][1]:.3f} m",
+        f"carry {100 * d['stiff_share_of_steps']:.1f} % of the steps",
+        f"bounds are {q['work_bound_s']:.1f} s and {q['latency_bound_s']:.1f} s",
+        f"takes {sp(q['longest_lane_steps'])} steps",
+        f"in at most {sp(r['steps_max'])} steps against {sp(r['tsit5_steps_max'])}",
+        f"{r['steps_total'] / 1e6:.1f} M in all against {r['tsit5_steps_total'] / 1e6:.1f} M",
+        f"took {r['wall_s_including_compile']:.0f} s with Kvaerno5",
+        f"{q['slot_step_rate_needed_x']:.2f}× (without the sticking lanes) to {p['slot_step_rate_needed_x']:.2f}× (with them)",
+    ]
+    for quote in quotes:
+        assert quote in text, quote
