@@ -527,3 +527,34 @@ def test_gpu_projection_from_step_census_json():
     ]
     for quote in quotes:
         assert quote in text, quote
+
+
+def test_map_window_check_from_json():
+    """The window check in docs/map/README.md against docs/map/lyapunov_window_check.json
+    (scripts/map_lyapunov_check.py)."""
+    text = " ".join(_text("docs/map/README.md").split())
+    d = _json("docs/map/lyapunov_window_check.json")
+    s, runs = d["summary"], d["runs"]
+    low = [i for i, lane in enumerate(d["lanes"]) if lane["group"] == "low"]
+    per = [i for i in low if runs["long_transient"]["label"][i].startswith("period")]
+    assert len(per) == s["low_periodic_after_long_transient"]
+
+    def rng(run, idx):
+        v = [runs[run]["lyapunov_per_s"][i] for i in idx if runs[run]["lyapunov_per_s"][i] is not None]
+        return f"{min(v):.2f} to {max(v):.2f}".replace("-", "−")
+
+    cm = s["chaotic_median_lyapunov_per_s"]
+    quotes = [
+        f"runs {s['low_lanes']} lanes of the lower left",
+        f"With the map's windows {s['low_chaotic_with_map_windows']} of the {s['low_lanes']} lanes are labelled chaotic",
+        f"After 300 transient periods {s['low_periodic_after_long_transient']} of the {s['low_lanes']} are period-1",
+        f"({sum(runs['map']['label'][i] == 'chaotic' for i in per)} of these were chaotic",
+        f"over 160 periods their λ₁ is {rng('long_lyapunov', per)} s⁻¹",
+        f"λ₁ over 10 periods is {rng('long_transient', per)} s⁻¹",
+        f"({sum(runs['long_transient']['lyapunov_per_s'][i] > 0.02 for i in per)} of {len(per)} above",
+        f"All {s['chaotic_chaotic_with_both_windows']} lanes there are chaotic with both windows",
+        f"from {cm['map']:.2f} s⁻¹ over 10 periods to {cm['lyapunov_40']:.2f} over 40 and {cm['long_lyapunov']:.3f} over 160",
+        f"again {cm['long_transient']:.2f} s⁻¹",
+    ]
+    for quote in quotes:
+        assert quote in text, quote
