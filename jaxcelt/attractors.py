@@ -5,9 +5,11 @@ Every start state is one lane of `jaxcelt.sweep` (same parameters, ``y0`` per la
 ``sample_periods`` periods and labelled by `jaxcelt.regimes.classify`:
 
 * ``periodic`` with period k (the smallest k with x_{j+k} = x_j on the section, to ``tol``);
-* ``quasi-periodic`` / ``chaotic`` by the largest Lyapunov exponent when the sweep computed
-  it (``lyapunov_periods > 0``), else ``aperiodic`` (not periodic up to ``sample_periods // 2``,
-  not further resolved: possibly still in its transient);
+* ``chaotic`` / ``quasi-periodic`` / ``converging`` (a negative exponent: attracted to a periodic
+  orbit not yet reached) / ``uncertain`` by the largest Lyapunov exponent and its standard error
+  when the sweep computed it (``lyapunov_periods > 0``; `jaxcelt.regimes.classify`), else
+  ``aperiodic`` (not periodic up to ``sample_periods // 2``, not further resolved: possibly
+  still in its transient);
 * ``invalid`` (the model left its validity: lift-off, n3 <= 0) and ``failed`` (the solve did
   not finish) from the lane's status.
 
@@ -164,7 +166,8 @@ def same_cycle(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
 class Attractor:
     """One row of the census table.
 
-    kind: ``periodic``, ``quasi-periodic``, ``chaotic``, ``aperiodic``, ``invalid`` or ``failed``;
+    kind: ``periodic``, ``converging``, ``quasi-periodic``, ``chaotic``, ``uncertain``, ``aperiodic``,
+    ``invalid`` or ``failed`` (`jaxcelt.regimes.REGIMES`);
     k: period (0 unless periodic); state: representative section state (13,) (last sample of
     the representative lane; nan if none finite); t_section: its time [s]; lane: that lane;
     count, fraction: lanes in the row and their share of all lanes; lyapunov: median exponent
@@ -274,7 +277,7 @@ def group(
         else:
             label[i] = len(rows)
             rows.append(("periodic", int(periods[i]), i))
-    for kind in ("quasi-periodic", "chaotic", "aperiodic", "invalid", "failed"):
+    for kind in ("converging", "quasi-periodic", "chaotic", "uncertain", "aperiodic", "invalid", "failed"):
         idx = np.flatnonzero(np.asarray(kinds) == kind)
         if idx.size:
             label[idx] = len(rows)
@@ -351,6 +354,7 @@ def attractors(
         np.asarray(r.valid)[0],
         np.asarray(r.r_O)[0],
         lyap if have_lyap else None,
+        lyapunov_stderr=np.asarray(r.lyapunov_stderr, dtype=float)[0] if have_lyap else None,
         max_period=int(sample_periods) // 2,
         tol=tol,
         chaos_threshold=chaos_threshold,

@@ -65,6 +65,7 @@ LANE_FIELDS = (
     "max_excursion",
     "num_steps",
     "lyapunov",
+    "lyapunov_stderr",
     "r_O",
 )
 """per-lane arrays of a sweep (the fields of `jaxcelt.sweep.SweepResult` but ``values``), in
@@ -90,6 +91,7 @@ _DOCS = {
     "max_excursion": ("max horizontal distance of O from its first-sample position", "m"),
     "num_steps": ("solver steps of the main solve", ""),
     "lyapunov": ("largest Lyapunov exponent (NaN: not computed or failed)", "1/s"),
+    "lyapunov_stderr": ("batch-means standard error of lyapunov over 4 sub-windows of its window", "1/s"),
     "r_O": ("global position of the geometric centre O at the samples", "m"),
     "y_final": ("last section state (continuation start)", "SI"),
     "regime": ("local regime code, see attrs['regime_codes']", ""),
@@ -149,7 +151,10 @@ def _lane_variables(fields: dict[str, Any], lead: tuple[str, ...], **classify_kw
         desc, units = _DOCS[out]
         data[out] = xr.Variable(lead + _LANE_DIMS.get(key, ()), arr, attrs={"long_name": desc, "units": units})
     f = fields
-    labels = classify(f["samples"], f["status"], f["valid"], f["r_O"], f["lyapunov"], **classify_kwargs)
+    labels = classify(
+        f["samples"], f["status"], f["valid"], f["r_O"], f["lyapunov"], lyapunov_stderr=f["lyapunov_stderr"],
+        **classify_kwargs,
+    )  # fmt: skip
     for key, arr in labels.items():
         desc, units = _DOCS[key]
         data[key] = xr.Variable(lead, arr, attrs={"long_name": desc, "units": units})

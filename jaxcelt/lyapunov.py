@@ -49,12 +49,23 @@ from .contact import AbstractContactLaw, get_contact_law
 from .model import contact_geometry, vector_field
 from .params import CeltParams
 
-__all__ = ["LyapunovResult", "largest_lyapunov", "celt_lyapunov", "celt_tangent_projection", "CELT_NORM_MASK"]
+__all__ = [
+    "LyapunovResult",
+    "largest_lyapunov",
+    "celt_lyapunov",
+    "celt_tangent_projection",
+    "exponent_stderr",
+    "CELT_NORM_MASK",
+    "STDERR_BLOCKS",
+]
 
 # numpy, not jnp: a module-level jnp array would initialise the JAX backend on import
 # (then `jax.config.update("jax_num_cpu_devices", n)` could no longer be set)
 CELT_NORM_MASK = np.array([1.0] * 9 + [0.0] * 3 + [1.0])
 """Weights of the 13 state components in the tangent norm: r_C (9:12) excluded."""
+
+STDERR_BLOCKS = 4
+"""Sub-windows of the batch-means standard error of the exponent (`exponent_stderr`)."""
 
 
 class LyapunovResult(NamedTuple):
@@ -72,6 +83,41 @@ class LyapunovResult(NamedTuple):
     """all segment solves succeeded"""
     num_steps: Array
     """total solver steps"""
+    stderr: Scalar
+    """batch-means standard error of ``exponent`` over `STDERR_BLOCKS` sub-windows
+    (`exponent_stderr`; NaN with fewer segments than sub-windows or if a segment failed)"""
+
+
+def exponent_stderr(log_growth: Array, segment: Array, n_blocks: int = STDERR_BLOCKS) -> Array:
+    """Batch-means standard error of a finite-time exponent from its per-segment log growths.
+
+    The window's segments are split into ``n_blocks`` consecutive sub-windows (sizes differing by at
+    most one segment); each gives its own exponent lambda_b = sum(log growth) / (its length), and the
+    standard error of the whole window's exponent is std(lambda_b, ddof=1) / sqrt(n_blocks).
+
+    This measures how much the estimate still moves within the window: on a chaotic attractor the
+    per-segment growths fluctuate, and on a periodic orbit whose monodromy is far from normal the
+    tangent vector's growth over a segment depends on its direction, which turns from segment to
+    segment; both give sub-window exponents that disagree. It is a heuristic: the sub-windows are
+    correlated and few, so read +-2 standard errors as a rough interval, not a confidence level.
+
+    Args:
+        log_growth: (..., n_segments) log of the tangent growth per segment.
+        segment: the segment's length (broadcast against the leading axes).
+        n_blocks: sub-windows (>= 2); NaN if there are fewer segments than that.
+    """
+    if isinstance(n_blocks, bool) or not isinstance(n_blocks, int) or n_blocks < 2:
+        raise ValueError(f"exponent_stderr: 'n_blocks' must be an int >= 2, got {n_blocks!r}")
+    log_growth = jnp.asarray(log_growth)
+    n = log_growth.shape[-1]
+    if n < n_blocks:
+        return jnp.full(log_growth.shape[:-1], jnp.nan, log_growth.dtype)
+    edges = np.linspace(0, n, n_blocks + 1).round().astype(int)  # static: the window's length is
+    seg = jnp.asarray(segment, log_growth.dtype)
+    lam_b = jnp.stack(
+        [jnp.sum(log_growth[..., a:b], axis=-1) / ((b - a) * seg) for a, b in zip(edges[:-1], edges[1:])], axis=-1
+    )
+    return jnp.std(lam_b, axis=-1, ddof=1) / np.sqrt(n_blocks)
 
 
 def _unit_direction(dim: int, dtype) -> Array:
@@ -160,8 +206,12 @@ def largest_lyapunov(
     (yf, _, ok, steps), (logs, ys) = jax.lax.scan(one, init, jnp.arange(n_tot))
     logs, ys = logs[n_transient_segments:], ys[n_transient_segments:]
     lam = jnp.sum(logs) / (n_segments * seg)
-    lam = jnp.where(ok & jnp.all(jnp.isfinite(logs)), lam, jnp.nan)
-    return LyapunovResult(exponent=lam, log_growth=logs, samples=ys, y_final=yf, success=ok, num_steps=steps)
+    good = ok & jnp.all(jnp.isfinite(logs))
+    lam = jnp.where(good, lam, jnp.nan)
+    err = jnp.where(good, exponent_stderr(logs, seg), jnp.nan)
+    return LyapunovResult(
+        exponent=lam, log_growth=logs, samples=ys, y_final=yf, success=ok, num_steps=steps, stderr=err
+    )
 
 
 def celt_tangent_projection(y: Array, dy: Array, params: CeltParams) -> Array:

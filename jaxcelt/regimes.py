@@ -12,8 +12,19 @@ with psi determine the dynamics; r_C does not feed back):
   lane was stopped there (status 2, ``stop_on_invalid``);
 * ``period-k`` -- smallest k <= ``max_period`` with max_j |x_{j+k} - x_j| <= tol (1 + max|x|)
   over the samples; k = 1 is the forcing period (a period-1 orbit of the stroboscopic map);
-* otherwise ``chaotic`` if the largest Lyapunov exponent exceeds ``chaos_threshold`` [1/s],
-  ``quasi-periodic`` if it does not, ``aperiodic`` if no exponent was computed.
+* otherwise, from the largest Lyapunov exponent lambda_1 and, where it comes with one, its
+  standard error s (`jaxcelt.lyapunov.exponent_stderr`; s = 0 if not given), with the interval
+  [lo, hi] = lambda_1 -+ ``confidence`` s and th = ``chaos_threshold`` [1/s]:
+
+  - ``chaotic``        -- lo > th;
+  - ``converging``     -- hi < -th: no period was found in the samples, but every perturbation
+    shrinks, so the lane is attracted to a periodic orbit (on the stroboscopic section an
+    attractor with a negative largest exponent is a sink) that it has not reached to the
+    detector's tolerance yet: a slowly attracting orbit, or a period above ``max_period``;
+  - ``quasi-periodic`` -- -th <= lo and hi <= th (an exponent indistinguishable from 0);
+  - ``uncertain``      -- the interval reaches across +-th: the window was too short to tell,
+    integrate the exponent over more periods;
+  - ``aperiodic``      -- no exponent was computed.
 
 Global label: ``unbounded`` when O's net horizontal displacement over the samples exceeds
 ``drift_threshold`` [m] and is at least half of its maximum excursion (steady wandering
@@ -27,7 +38,16 @@ import numpy as np
 
 __all__ = ["REGIMES", "GLOBAL_MOTION", "detect_period", "classify", "regime_names"]
 
-REGIMES: dict[int, str] = {0: "failed", 1: "invalid", 2: "periodic", 3: "quasi-periodic", 4: "chaotic", 5: "aperiodic"}
+REGIMES: dict[int, str] = {
+    0: "failed",
+    1: "invalid",
+    2: "periodic",
+    3: "quasi-periodic",
+    4: "chaotic",
+    5: "aperiodic",
+    6: "converging",
+    7: "uncertain",
+}
 """Integer codes of the local regime (periodic carries its period k separately)."""
 GLOBAL_MOTION: dict[int, str] = {0: "bounded", 1: "unbounded", -1: "unknown"}
 
@@ -60,9 +80,11 @@ def classify(
     r_O: np.ndarray,
     lyapunov: np.ndarray | None = None,
     *,
+    lyapunov_stderr: np.ndarray | None = None,
     max_period: int = 16,
     tol: float = 1e-4,
     chaos_threshold: float = 0.02,
+    confidence: float = 2.0,
     drift_threshold: float = 0.05,
 ) -> dict[str, np.ndarray]:
     """Labels for every lane (any leading shape ``...``).
@@ -70,9 +92,12 @@ def classify(
     Args:
         samples: section states (..., S, 13). status, valid: (...). r_O: (..., S, 3) [m].
         lyapunov: (...) [1/s] or None.
+        lyapunov_stderr: (...) standard errors of ``lyapunov`` [1/s], or None (no error known:
+            the point estimate decides); NaN entries count as 0.
         max_period, tol: see `detect_period`.
-        chaos_threshold: exponent above which a non-periodic lane is chaotic [1/s]; the
+        chaos_threshold: [1/s] an exponent above it is chaos, below minus it a sink; the
             finite-time estimate of a quasi-periodic orbit is O(1/t) from 0.
+        confidence: half-width of the exponent's interval in standard errors.
         drift_threshold: net displacement of O that counts as unbounded wandering [m].
 
     Returns:
@@ -86,6 +111,13 @@ def classify(
     va = np.asarray(valid).reshape(-1)
     ro = np.asarray(r_O).reshape(-1, *np.shape(r_O)[-2:])
     ly = None if lyapunov is None else np.asarray(lyapunov, dtype=float).reshape(-1)
+    if not (np.isfinite(chaos_threshold) and chaos_threshold >= 0):
+        raise ValueError(f"classify: 'chaos_threshold' must be finite and >= 0, got {chaos_threshold!r}")
+    if not (np.isfinite(confidence) and confidence >= 0):
+        raise ValueError(f"classify: 'confidence' must be finite and >= 0, got {confidence!r}")
+    se = np.zeros(flat.shape[0])
+    if lyapunov_stderr is not None:
+        se = np.nan_to_num(np.asarray(lyapunov_stderr, dtype=float).reshape(-1), nan=0.0, posinf=np.inf)
     regime = np.zeros(flat.shape[0], dtype=np.int32)
     period = np.zeros(flat.shape[0], dtype=np.int32)
     glob = np.full(flat.shape[0], -1, dtype=np.int32)
@@ -102,7 +134,15 @@ def classify(
         elif k > 0:
             regime[i], period[i] = 2, k
         elif ly is not None and np.isfinite(ly[i]):
-            regime[i] = 4 if ly[i] > chaos_threshold else 3
+            lo, hi = ly[i] - confidence * se[i], ly[i] + confidence * se[i]
+            if lo > chaos_threshold:
+                regime[i] = 4
+            elif hi < -chaos_threshold:
+                regime[i] = 6
+            elif lo >= -chaos_threshold and hi <= chaos_threshold:
+                regime[i] = 3
+            else:
+                regime[i] = 7
         else:
             regime[i] = 5
         d = ro[i][:, :2] - ro[i][0, :2]

@@ -145,6 +145,8 @@ class SweepResult(eqx.Module):
         max_excursion: max horizontal distance of O from its first-sample position [m], (L,)
         num_steps: solver steps (main solve), (L,)
         lyapunov: largest Lyapunov exponent [1/s] (NaN if not computed / failed), (L,)
+        lyapunov_stderr: its batch-means standard error over 4 sub-windows [1/s]
+            (`jaxcelt.lyapunov.exponent_stderr`; NaN where ``lyapunov`` is, or with < 4 periods), (L,)
         r_O: global position of the geometric centre at the samples [m], (L, S, 3)
     """
 
@@ -163,6 +165,7 @@ class SweepResult(eqx.Module):
     max_excursion: np.ndarray
     num_steps: np.ndarray
     lyapunov: np.ndarray
+    lyapunov_stderr: np.ndarray
     r_O: np.ndarray
 
     @property

@@ -11,6 +11,11 @@ docs/map/lyapunov_window_check.json:
 * ``lyapunov_40``, ``long_lyapunov``: lambda_1 over 40 and 160 periods instead of 10;
 * ``long_transient``: 300 transient periods before the 20 samples, lambda_1 over 10.
 
+Each run's labels are recorded twice: ``label`` by the sweep's rule (the exponent's interval of
++-2 batch-means standard errors, `jaxcelt.regimes.classify`) and ``label_point_estimate`` from the
+exponent alone (no standard error), so the two rules can be compared on lanes whose long-window
+answer is known.
+
     python scripts/map_lyapunov_check.py [--json docs/map/lyapunov_window_check.json]
 """
 
@@ -40,7 +45,7 @@ def main() -> int:
     a = ap.parse_args()
 
     import jaxcelt as jc
-    from jaxcelt.regimes import regime_names
+    from jaxcelt.regimes import classify, regime_names
     from jaxcelt.versions import versions
 
     p = jc.CeltParams.paper()
@@ -59,11 +64,16 @@ def main() -> int:
         t = time.perf_counter()
         ds = jc.sweep_lanes(p, lanes, stop_on_invalid=True, max_steps=10_000_000, progress=True, **kw)
         lam = ds["lyapunov"].values
+        err = ds["lyapunov_stderr"].values
+        point = classify(ds["section"].values, ds["status"].values, ds["valid"].values.astype(bool),
+                         ds["r_O"].values, lam)  # fmt: skip
         rec["runs"][name] = {
             **kw,
             "seconds": round(time.perf_counter() - t, 1),
             "lyapunov_per_s": [None if not np.isfinite(x) else round(float(x), 4) for x in lam],
+            "lyapunov_stderr_per_s": [None if not np.isfinite(x) else round(float(x), 4) for x in err],
             "label": [str(s) for s in regime_names(ds["regime"].values, ds["period"].values)],
+            "label_point_estimate": [str(s) for s in regime_names(point["regime"], point["period"])],
             "status": [int(s) for s in ds["status"].values],
         }
         print(name, json.dumps(rec["runs"][name]), flush=True)
@@ -75,15 +85,23 @@ def main() -> int:
         vals = [rec["runs"][run]["lyapunov_per_s"][i] for i in idx]
         return round(float(np.median([v for v in vals if v is not None])), 3)  # None: stopped invalid
 
+    def counts(run, idx, key="label"):
+        labels = [rec["runs"][run][key][i] for i in idx]
+        return {k: labels.count(k) for k in sorted(set(labels))}
+
     rec["summary"] = {
         "low_lanes": len(low),
-        "low_chaotic_with_map_windows": sum(m["label"][i] == "chaotic" for i in low),
-        "low_chaotic_with_long_lyapunov": sum(lg["label"][i] == "chaotic" for i in low),
+        "low_labels": {run: counts(run, low) for run in RUNS},
+        "low_labels_point_estimate": {run: counts(run, low, "label_point_estimate") for run in RUNS},
+        "chaotic_labels": {run: counts(run, ch) for run in RUNS},
+        "chaotic_labels_point_estimate": {run: counts(run, ch, "label_point_estimate") for run in RUNS},
+        "low_chaotic_with_map_windows": sum(m["label_point_estimate"][i] == "chaotic" for i in low),
+        "low_chaotic_with_long_lyapunov": sum(lg["label_point_estimate"][i] == "chaotic" for i in low),
         "low_negative_long_lyapunov": sum((lg["lyapunov_per_s"][i] or 0) < 0 for i in low),
         "low_periodic_after_long_transient": sum(lt["label"][i].startswith("period") for i in low),
         "chaotic_lanes": len(CHAOTIC),
         "chaotic_chaotic_with_both_windows": sum(
-            m["label"][i] == "chaotic" and lg["label"][i] == "chaotic" for i in ch
+            m["label_point_estimate"][i] == "chaotic" and lg["label_point_estimate"][i] == "chaotic" for i in ch
         ),
         "chaotic_median_lyapunov_per_s": {run: med(run, ch) for run in RUNS},
         "low_median_lyapunov_per_s": {run: med(run, low) for run in RUNS},

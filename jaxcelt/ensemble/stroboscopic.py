@@ -143,7 +143,8 @@ def _section_times(pb: CeltParams, transient: Array, cfg: SweepConfig) -> Array:
     return jnp.asarray(cfg.t0, dt) + T[:, None] * (transient.astype(dt) + jnp.arange(S, dtype=dt))[None, :]
 
 
-def _lyap_lane(p: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig) -> Array:
+def _lyap_lane(p: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig) -> tuple[Array, Array]:
+    """(lambda_1, its batch-means standard error) of one lane [1/s] (`jaxcelt.lyapunov.exponent_stderr`)."""
     lr = celt_lyapunov(
         p,
         y_start,
@@ -155,7 +156,7 @@ def _lyap_lane(p: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig) 
         atol=cfg.atol,
         max_steps=cfg.max_steps,  # per period: a bound, not a cost
     )
-    return lr.exponent
+    return lr.exponent, lr.stderr
 
 
 @eqx.filter_jit
@@ -196,7 +197,9 @@ def _pool_chunk(
     return shard_lanes(run, mesh, 3)(pb, y0b, live)
 
 
-def _lyap_chunk_impl(pb: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig, mesh: Any) -> Array:
+def _lyap_chunk_impl(
+    pb: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig, mesh: Any
+) -> tuple[Array, Array]:
     run = jax.vmap(lambda p, y, t: _lyap_lane(p, y, t, cfg))
     return shard_lanes(run, mesh, 3)(pb, y_start, t_start)
 
@@ -303,6 +306,7 @@ def run_lanes_with_stats(
     out = {k: v.astype(np.float64) if v.dtype == np.float32 else v for k, v in out.items()}
     out["valid"] = out["first_invalid_kind"] == 0
     out["lyapunov"] = np.full(L, np.nan)
+    out["lyapunov_stderr"] = np.full(L, np.nan)
     if cfg.lyapunov_periods > 0 and not compile_only:
         ok = np.flatnonzero(out["status"] == 0)
         ok = ok[np.argsort(-out["num_steps"][ok], kind="stable")]  # similar cost side by side
@@ -312,7 +316,7 @@ def run_lanes_with_stats(
         start_deferred()
         for i in range(0, len(ok), G):
             idx = pad_lanes(ok[i : i + G], G)
-            lam = lyap(
+            lam, err = lyap(
                 jax.tree_util.tree_map(lambda x, idx=idx: x[idx], pb_np),
                 out["samples"][idx, 0],  # float64 (a float32 pool's samples cast up)
                 out["t_samples"][idx, 0],
@@ -321,6 +325,7 @@ def run_lanes_with_stats(
             )
             n = min(G, len(ok) - i)
             out["lyapunov"][idx[:n]] = np.asarray(lam)[:n]
+            out["lyapunov_stderr"][idx[:n]] = np.asarray(err)[:n]
     return out, stats
 
 

@@ -13,6 +13,8 @@ REGIME_COLOURS = {
     "quasi-periodic": "#2ca02c",
     "chaotic": "#d62728",
     "aperiodic": "#9467bd",
+    "converging": "#17becf",
+    "uncertain": "#e6ab02",
     "invalid": "#7f7f7f",
     "failed": "#000000",
 }

@@ -26,13 +26,23 @@ _CATEGORIES = (
     ("period-1", "#08519c"),
     ("period-2", "#4292c6"),
     ("period 3-16", "#9ecae1"),
+    ("converging", REGIME_COLOURS["converging"]),
     ("quasi-periodic", REGIME_COLOURS["quasi-periodic"]),
     ("chaotic", REGIME_COLOURS["chaotic"]),
     ("aperiodic", REGIME_COLOURS["aperiodic"]),
+    ("uncertain", REGIME_COLOURS["uncertain"]),
     ("invalid", "#bdbdbd"),
     ("failed", REGIME_COLOURS["failed"]),
 )
-_REGIME_CATEGORY = {3: "quasi-periodic", 4: "chaotic", 5: "aperiodic", 1: "invalid", 0: "failed"}
+_REGIME_CATEGORY = {
+    3: "quasi-periodic",
+    4: "chaotic",
+    5: "aperiodic",
+    6: "converging",
+    7: "uncertain",
+    1: "invalid",
+    0: "failed",
+}
 
 
 def map_categories(regime: np.ndarray, period: np.ndarray) -> tuple[np.ndarray, list[tuple[str, str]]]:
