@@ -16,6 +16,11 @@ Each run's labels are recorded twice: ``label`` by the sweep's rule (the exponen
 exponent alone (no standard error), so the two rules can be compared on lanes whose long-window
 answer is known.
 
+The lanes found period-1 after the long transient are then refined with `jaxcelt.periodic_orbit`
+(Newton on the stroboscopic map from the last sample, Tsit5 rtol 1e-9) for their Floquet exponent
+log|mu_max| / T: the exact largest exponent of the orbit, against which the finite-time exponents
+and their standard errors are checked (``floquet``).
+
     python scripts/map_lyapunov_check.py [--json docs/map/lyapunov_window_check.json]
 """
 
@@ -60,9 +65,11 @@ def main() -> int:
         "lanes": [{"omega_pi": w, "q_pi": q, "group": "low" if (w, q) in LOW else "chaotic"} for w, q in pts],
         "runs": {},
     }
+    datasets = {}
     for name, kw in RUNS.items():
         t = time.perf_counter()
         ds = jc.sweep_lanes(p, lanes, stop_on_invalid=True, max_steps=10_000_000, progress=True, **kw)
+        datasets[name] = ds
         lam = ds["lyapunov"].values
         err = ds["lyapunov_stderr"].values
         point = classify(ds["section"].values, ds["status"].values, ds["valid"].values.astype(bool),
@@ -77,6 +84,31 @@ def main() -> int:
             "status": [int(s) for s in ds["status"].values],
         }
         print(name, json.dumps(rec["runs"][name]), flush=True)
+    import diffrax
+
+    lt_ds = datasets["long_transient"]
+    floquet = []
+    t = time.perf_counter()
+    for i, label in enumerate(rec["runs"]["long_transient"]["label"]):
+        if label != "period-1":
+            continue
+        w, q = pts[i]
+        o = jc.periodic_orbit(
+            p.replace(omega_pi=w, q_pi=q), lt_ds["section"].values[i, -1], k=1,
+            t0=float(lt_ds["t_section"].values[i, -1]), solver=diffrax.Tsit5(), rtol=1e-9, atol=1e-11,
+            newton_tol=1e-6, max_steps=50_000,
+        )  # fmt: skip
+        lg_run = rec["runs"]["long_lyapunov"]
+        lam, err = lg_run["lyapunov_per_s"][i], lg_run["lyapunov_stderr_per_s"][i]
+        fe = float(o.floquet_exponent)
+        floquet.append({
+            "lane": i, "omega_pi": w, "q_pi": q, "status": int(o.status), "residual": float(o.residual),
+            "max_multiplier": round(float(o.max_multiplier), 5), "floquet_exponent_per_s": round(fe, 4),
+            "long_lyapunov_per_s": lam, "long_lyapunov_stderr_per_s": err,
+            "within_2_stderr": bool(abs(lam - fe) <= 2 * err),
+        })  # fmt: skip
+        print("floquet", json.dumps(floquet[-1]), flush=True)
+    rec["floquet"] = {"seconds": round(time.perf_counter() - t, 1), "orbits": floquet}
     low = [i for i, (w, q) in enumerate(pts) if (w, q) in LOW]
     m, lg, lt = (rec["runs"][k] for k in ("map", "long_lyapunov", "long_transient"))
     ch = range(len(low), len(pts))
@@ -99,6 +131,9 @@ def main() -> int:
         "low_chaotic_with_long_lyapunov": sum(lg["label_point_estimate"][i] == "chaotic" for i in low),
         "low_negative_long_lyapunov": sum((lg["lyapunov_per_s"][i] or 0) < 0 for i in low),
         "low_periodic_after_long_transient": sum(lt["label"][i].startswith("period") for i in low),
+        "floquet_converged_stable": sum(f["status"] == 0 and f["max_multiplier"] < 1 for f in floquet),
+        "floquet_within_2_stderr": sum(f["within_2_stderr"] for f in floquet),
+        "floquet_orbits": len(floquet),
         "chaotic_lanes": len(CHAOTIC),
         "chaotic_chaotic_with_both_windows": sum(
             m["label_point_estimate"][i] == "chaotic" and lg["label_point_estimate"][i] == "chaotic" for i in ch

@@ -544,17 +544,37 @@ def test_map_window_check_from_json():
         return f"{min(v):.2f} to {max(v):.2f}".replace("-", "−")
 
     cm = s["chaotic_median_lyapunov_per_s"]
+    fl = d["floquet"]["orbits"]
+    fe = [o["floquet_exponent_per_s"] for o in fl]
+    mu = [o["max_multiplier"] for o in fl]
+    lo, lg = s["low_labels"], runs["long_lyapunov"]
+    err_map = [runs["map"]["lyapunov_stderr_per_s"][i] for i in low]
+    band = [i for i, lane in enumerate(d["lanes"]) if lane["group"] == "chaotic"]
+    band_chaotic = [i for i in band if runs["map"]["label"][i] == "chaotic"]
     quotes = [
         f"runs {s['low_lanes']} lanes of the lower left",
-        f"With the map's windows {s['low_chaotic_with_map_windows']} of the {s['low_lanes']} lanes are labelled chaotic",
+        f"From the point estimate with the map's windows {s['low_chaotic_with_map_windows']} of the {s['low_lanes']} lanes are chaotic",
         f"After 300 transient periods {s['low_periodic_after_long_transient']} of the {s['low_lanes']} are period-1",
-        f"({sum(runs['map']['label'][i] == 'chaotic' for i in per)} of these were chaotic",
+        f"({sum(runs['map']['label_point_estimate'][i] == 'chaotic' for i in per)} of these were chaotic",
         f"over 160 periods their λ₁ is {rng('long_lyapunov', per)} s⁻¹",
+        f"converges for all {s['floquet_converged_stable']} to stable orbits with |μ_max| {min(mu):.3f}–{max(mu):.3f}",
+        f"Floquet exponents {min(fe):.3f} to {max(fe):.3f} s⁻¹ ({d['floquet']['seconds']:.1f} s for the {len(fl)})".replace("-", "−"),
+        f"for {s['floquet_within_2_stderr']} of {s['floquet_orbits']}",
         f"λ₁ over 10 periods is {rng('long_transient', per)} s⁻¹",
         f"({sum(runs['long_transient']['lyapunov_per_s'][i] > 0.02 for i in per)} of {len(per)} above",
-        f"All {s['chaotic_chaotic_with_both_windows']} lanes there are chaotic with both windows",
+        f"With the map's windows all {lo['map']['uncertain']} lanes are *uncertain*",
+        f"(standard errors {min(err_map):.2f}–{max(err_map):.2f} s⁻¹)",
+        f"over 160 periods {lo['long_lyapunov']['converging']} are *converging*, {lo['long_lyapunov']['uncertain']} "
+        f"*uncertain* and {lo['long_lyapunov']['chaotic']} *chaotic*",
+        f"All {s['chaotic_chaotic_with_both_windows']} lanes there are chaotic by the point estimate with both windows",
         f"from {cm['map']:.2f} s⁻¹ over 10 periods to {cm['lyapunov_40']:.2f} over 40 and {cm['long_lyapunov']:.3f} over 160",
         f"again {cm['long_transient']:.2f} s⁻¹",
+        f"By the sweeps' rule {len(band_chaotic)} of the {len(band)} are still *chaotic* with the map's windows",
+        " and ".join(f"{runs['map']['lyapunov_per_s'][i]:.2f} ± {runs['map']['lyapunov_stderr_per_s'][i]:.2f}" for i in band_chaotic),
+        f"all {s['chaotic_labels']['long_lyapunov']['uncertain']} are *uncertain* over 40 and 160 periods",
+        f"the 19 lanes take {runs['map']['seconds']:.1f} s with λ₁ over 10 periods and {lg['seconds']:.1f} s over",
     ]
+    assert s["chaotic_labels"]["lyapunov_40"] == {"uncertain": len(band)}
+    assert lo["lyapunov_40"] == {"uncertain": s["low_lanes"]}
     for quote in quotes:
         assert quote in text, quote

@@ -40,8 +40,9 @@ def register(sub) -> None:
     p.add_argument(
         "--lyapunov",
         type=nonnegative_int,
-        default=30,
-        help="periods of tangent dynamics for the Lyapunov exponent (0: off)",
+        default=150,
+        help="periods of tangent dynamics for the Lyapunov exponent (0: off); labels need a long window "
+        "(the exponent's standard error shrinks roughly as 1/sqrt(periods))",
     )
     p.add_argument(
         "--set",
