@@ -112,7 +112,7 @@ def exponent_stderr(log_growth: Array, segment: Array, n_blocks: int = STDERR_BL
     n = log_growth.shape[-1]
     if n < n_blocks:
         return jnp.full(log_growth.shape[:-1], jnp.nan, log_growth.dtype)
-    edges = np.linspace(0, n, n_blocks + 1).round().astype(int)  # static: the window's length is
+    edges = np.linspace(0, n, n_blocks + 1).round().astype(int)  # the window's length is static
     seg = jnp.asarray(segment, log_growth.dtype)
     lam_b = jnp.stack(
         [jnp.sum(log_growth[..., a:b], axis=-1) / ((b - a) * seg) for a, b in zip(edges[:-1], edges[1:])], axis=-1

@@ -117,7 +117,8 @@ def classify(
         raise ValueError(f"classify: 'confidence' must be finite and >= 0, got {confidence!r}")
     se = np.zeros(flat.shape[0])
     if lyapunov_stderr is not None:
-        se = np.nan_to_num(np.asarray(lyapunov_stderr, dtype=float).reshape(-1), nan=0.0, posinf=np.inf)
+        se = np.asarray(lyapunov_stderr, dtype=float).reshape(-1)
+        se = np.where(np.isnan(se), 0.0, se)
     regime = np.zeros(flat.shape[0], dtype=np.int32)
     period = np.zeros(flat.shape[0], dtype=np.int32)
     glob = np.full(flat.shape[0], -1, dtype=np.int32)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..regimes import REGIMES
 from .bifurcation import REGIME_COLOURS
 
 __all__ = ["map_figure", "map_categories", "PARAM_LABELS"]
@@ -34,15 +35,7 @@ _CATEGORIES = (
     ("invalid", "#bdbdbd"),
     ("failed", REGIME_COLOURS["failed"]),
 )
-_REGIME_CATEGORY = {
-    3: "quasi-periodic",
-    4: "chaotic",
-    5: "aperiodic",
-    6: "converging",
-    7: "uncertain",
-    1: "invalid",
-    0: "failed",
-}
+_REGIME_CATEGORY = {code: name for code, name in REGIMES.items() if name != "periodic"}
 
 
 def map_categories(regime: np.ndarray, period: np.ndarray) -> tuple[np.ndarray, list[tuple[str, str]]]:
