@@ -122,7 +122,7 @@ QUOTES = [
     (
         "docs/bifurcation/README.md",
         lambda: (
-            f"met — {_json('docs/bifurcation/main_job_compile.json')['command_compile_overhead_s_median']:.1f} s for the "
+            f"— {_json('docs/bifurcation/main_job_compile.json')['command_compile_overhead_s_median']:.1f} s for the "
             f"whole command, {_json('docs/bifurcation/main_job_compile.json')['sweep_compile_overhead_s_median']:.1f} s"
         ),
     ),
