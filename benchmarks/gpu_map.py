@@ -11,6 +11,12 @@ cell by cell.
     python benchmarks/gpu_map.py --nx 400 --ny 400 --dtype float64 --json out/gpu_map.json
     python benchmarks/gpu_map.py --nx 400 --ny 400 --dtype float32 --rtol 1e-6 --atol 1e-8 ...
     python benchmarks/gpu_map.py --compare out/labels_float64_400x400.npz out/labels_float32_400x400.npz
+    python benchmarks/gpu_map.py --check --json out/gpu_map.json
+
+On a GPU the lanes run in the lane kernel (`jaxcelt.ensemble.kernel`, ``engine="auto"``);
+``--engine pool`` forces the lane pool. ``--check`` runs a small map of cheap lanes through both
+engines on the same device and records how far they agree (status, steps, samples).
+JAX's persistent compilation cache (a temporary directory) keeps the map from compiling twice.
 """
 
 from __future__ import annotations
@@ -52,13 +58,26 @@ def main() -> int:
     ap.add_argument("--json", type=Path, default=Path("out/gpu_map.json"), help="JSON list to append a record to")
     ap.add_argument("--labels", type=Path, default=None, help=".npz of the map's categories and status")
     ap.add_argument("--compare", nargs=2, type=Path, default=None, help="compare two --labels files and exit")
+    ap.add_argument("--engine", default="auto", choices=("auto", "pool", "kernel"))
+    ap.add_argument("--check", action="store_true", help="kernel against pool on a small map of cheap lanes")
+    ap.add_argument("--check-dtypes", nargs="+", default=["float64"], choices=("float64", "float32"))
     a = ap.parse_args()
     if a.compare:
         rec = compare(*a.compare)
         _append(a.json, {"comparison": rec})
         return 0
 
+    import tempfile
+
     import jax
+
+    jax.config.update("jax_compilation_cache_dir", tempfile.mkdtemp(prefix="jaxcelt-gpu-map-"))
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
+    jax.config.update("jax_persistent_cache_min_entry_size_bytes", 0)
+    if a.check:
+        rec = check(a)
+        _append(a.json, {"check": rec})
+        return 0
 
     import jaxcelt as jc
     from jaxcelt.ensemble import lanes_params, run_lanes
@@ -88,11 +107,15 @@ def main() -> int:
     y0 = np.tile(np.asarray(jc.initial_state(p)), (cs, 1))
     cfg = SweepConfig(**kw)
     t = time.perf_counter()
-    run_lanes(pb, y0, cfg, pad_to=cs, width=W, compile_only=True, varying=("omega_pi", "q_pi"))
+    run_lanes(pb, y0, cfg, pad_to=cs, width=W, compile_only=True, varying=("omega_pi", "q_pi"), engine=a.engine)
     t_compile = time.perf_counter() - t
     print(f"compile {t_compile:.1f} s", flush=True)
     t = time.perf_counter()
-    ds = jc.parameter_map(p, x=("omega_pi", xs), y=("q_pi", ys), chunk_size=cs, width=W, **kw)
+    if a.engine == "auto":
+        ds = jc.parameter_map(p, x=("omega_pi", xs), y=("q_pi", ys), chunk_size=cs, width=W, **kw)
+    else:  # the engine forced: the same lanes through run_lanes (no dataset)
+        ds = _as_map(run_lanes(pb_all(p, xs, ys), np.tile(np.asarray(jc.initial_state(p)), (L, 1)), cfg, width=W,
+                               varying=("omega_pi", "q_pi"), engine=a.engine), a.nx, a.ny)  # fmt: skip
     t_run = time.perf_counter() - t
     steps = ds["num_steps"].values
     status = ds["status"].values
@@ -111,6 +134,8 @@ def main() -> int:
         "atol": a.atol,
         "chunk": cs,
         "width": W,
+        "engine": a.engine,
+        "engine_used": "kernel" if (a.engine == "kernel" or (a.engine == "auto" and jax.devices()[0].platform == "gpu")) else "pool",
         "compile_s": round(t_compile, 2),
         "run_s": round(t_run, 2),
         "lanes_per_s": round(L / t_run, 1),
@@ -126,6 +151,65 @@ def main() -> int:
         a.labels.parent.mkdir(parents=True, exist_ok=True)
         np.savez_compressed(a.labels, category=cat, status=status, omega_pi=xs, q_pi=ys)
     return 0
+
+
+def pb_all(p, xs, ys):
+    import equinox as eqx
+    import jax.numpy as jnp
+
+    from jaxcelt.ensemble import lanes_params
+
+    lane_x, lane_y = np.repeat(xs, len(ys)), np.tile(ys, len(xs))
+    return eqx.tree_at(lambda q: q.q_pi, lanes_params(p, "omega_pi", lane_x), jnp.asarray(lane_y))
+
+
+def _as_map(out: dict, nx: int, ny: int):
+    import xarray as xr
+
+    from jaxcelt.regimes import classify
+
+    lab = classify(out["samples"], out["status"], out["valid"], out["r_O"])
+    fields = dict(num_steps=out["num_steps"], status=out["status"], regime=lab["regime"], period=lab["period"])
+    return xr.Dataset({k: (("x", "y"), np.asarray(v).reshape(nx, ny)) for k, v in fields.items()})
+
+
+def check(a) -> dict:
+    """Kernel against pool on one device: a small map of cheap lanes (no sticking)."""
+    import jax
+
+    import jaxcelt as jc
+    from jaxcelt.ensemble import run_lanes
+    from jaxcelt.sweep import SweepConfig
+    from jaxcelt.versions import versions
+
+    p = jc.CeltParams.paper()
+    xs, ys = np.linspace(15.0, 20.0, 8), np.linspace(0.04, 0.06, 8)
+    pb = pb_all(p, xs, ys)
+    y0 = np.tile(np.asarray(jc.initial_state(p)), (64, 1))
+    rec = {"versions": versions(), "device_kind": jax.devices()[0].device_kind, "grid": [8, 8], "omega_pi": [15, 20],
+           "q_pi": [0.04, 0.06], "periods": 10}  # fmt: skip
+    tols = {"float64": (1e-8, 1e-10), "float32": (1e-6, 1e-8)}
+    for dtype in a.check_dtypes:
+        rtol, atol = tols[dtype]
+        cfg = SweepConfig(transient_periods=7, sample_periods=3, rtol=rtol, atol=atol, stop_on_invalid=True, dtype=dtype)
+        res = {}
+        for engine in ("kernel", "pool"):  # the kernel first: if it fails, it fails fast
+            t = time.perf_counter()
+            res[engine] = run_lanes(pb, y0, cfg, varying=("omega_pi", "q_pi"), engine=engine)
+            rec[f"{dtype}_{engine}_s_incl_compile"] = round(time.perf_counter() - t, 2)
+        A, B = res["pool"], res["kernel"]
+        fin = np.isfinite(A["samples"]) & np.isfinite(B["samples"])
+        scale = np.maximum(np.abs(A["samples"]), 1e-3)
+        rec[dtype] = {
+            "same_status": int(np.sum(A["status"] == B["status"])),
+            "same_steps": int(np.sum(A["num_steps"] == B["num_steps"])),
+            "max_step_difference": int(np.max(np.abs(A["num_steps"] - B["num_steps"]))),
+            "same_finite_samples": bool(np.array_equal(np.isfinite(A["samples"]), np.isfinite(B["samples"]))),
+            "max_sample_difference_rel": float(np.max(np.where(fin, np.abs(A["samples"] - B["samples"]) / scale, 0))),
+            "status_counts": {str(k): int(v) for k, v in zip(*np.unique(B["status"], return_counts=True))},
+        }
+        print(json.dumps({dtype: rec[dtype]}), flush=True)
+    return rec
 
 
 def _append(path: Path, rec: dict) -> None:

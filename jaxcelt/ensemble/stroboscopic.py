@@ -30,6 +30,7 @@ from ..diagnostics import centre_position
 from ..lyapunov import celt_lyapunov
 from ..params import PARAM_NAMES, CeltParams
 from ..solve import DEFAULT_SOLVER
+from .kernel import BLOCK, kernel_supported, make_segment, run_kernel_lanes
 from .pool import (
     DEFAULT_WIDTH,
     DRAIN_FACTOR,
@@ -44,7 +45,12 @@ from .pool import (
 from .shard import device_mesh, pad_lanes, shard_lanes
 from .stepper import AbstractLaneStepper, erk_tableau, make_stepper
 
-__all__ = ["SweepConfig", "lanes_params", "run_lanes", "run_lanes_with_stats"]
+__all__ = ["SweepConfig", "lanes_params", "run_lanes", "run_lanes_with_stats", "ENGINES"]
+
+ENGINES = ("auto", "pool", "kernel")
+"""how lanes are stepped: ``"pool"`` (`jaxcelt.ensemble.pool`, any solver, any device),
+``"kernel"`` (`jaxcelt.ensemble.kernel`, explicit FSAL solvers; compiled for a GPU, interpreted
+elsewhere) or ``"auto"``: the kernel on a GPU where the solver allows it, else the pool"""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -197,6 +203,46 @@ def _pool_chunk(
     return shard_lanes(run, mesh, 3)(pb, y0b, live)
 
 
+@eqx.filter_jit
+def _kernel_chunk(
+    pv: tuple[Array, ...],
+    y0b: Array,
+    live: Array,
+    transient: Array,
+    tols: Array,
+    p_const: CeltParams,
+    cfg: SweepConfig,
+    vary: tuple[bool, ...],
+    mesh: Any,
+    interpret: bool,
+) -> tuple[dict[str, Array], Array]:
+    """One chunk of lanes through the lane kernel (per device): per-lane outputs and the kernel's
+    loop iterations per lane. ``p_const``: the parameters with plain Python numbers (static, so
+    that the kernel folds what depends on them alone); ``vary``: which of its leaves ``pv``
+    replaces (one (L,) array each)."""
+    leaves, treedef = jax.tree_util.tree_flatten(p_const)
+
+    def params_of(pv):
+        it = iter(pv)
+        return jax.tree_util.tree_unflatten(treedef, [next(it) if v else c for v, c in zip(vary, leaves)])
+
+    def run(pv, y0b, live):
+        L = y0b.shape[0]
+        pb = params_of(tuple(pv))
+        pb = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(jnp.asarray(x, cfg.dtype), (L,)), pb)
+        stepper = _stepper(cfg, None)
+        ts_all = _section_times(pb, transient, cfg)
+        t0 = jnp.asarray(cfg.t0, cfg.dtype)
+        lanes, _ = start_lanes(stepper, tuple(pv), params_of, y0b, ts_all, live, tols, t0)
+        seg = make_segment(cfg, params_of, len(pv))
+        out, samples, iters = run_kernel_lanes(seg, lanes, tuple(pv), ts_all, interpret)
+        out = dict(out, samples=samples, t_samples=ts_all)
+        out.update(jax.vmap(_extras)(samples, pb))
+        return out, iters
+
+    return shard_lanes(run, mesh, 3)(pv, y0b, live)
+
+
 def _lyap_chunk_impl(
     pb: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig, mesh: Any
 ) -> tuple[Array, Array]:
@@ -231,13 +277,20 @@ def run_lanes_with_stats(
     pilot_fraction: float = PILOT_FRACTION,
     drain_factor: int = DRAIN_FACTOR,
     min_drain_width: int = MIN_DRAIN_WIDTH,
+    engine: str = "auto",
 ) -> tuple[dict[str, np.ndarray], PoolStats]:
     """`run_lanes`, with the pool's statistics apart: (per-lane numpy arrays, `PoolStats` over
     all devices: the busiest device's iterations, the step slots paid by all, the width).
     ``drain_factor``, ``min_drain_width``: the pool's drain schedule (`jaxcelt.ensemble.pool`).
     ``devices`` may be a `jaxcelt.ensemble.HostProcesses`: the lanes then run in its worker
-    processes, one per CPU core."""
+    processes, one per CPU core. ``engine``: `ENGINES` (the kernel's `PoolStats` count its loop
+    iterations, one per step of its slowest lane, with ``width`` = `BLOCK`)."""
     from .processes import HostProcesses
+
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
+    if engine == "kernel" and not kernel_supported(cfg.solver):
+        raise ValueError(f"engine='kernel' needs an explicit FSAL Runge-Kutta solver, got {type(cfg.solver).__name__}")
 
     if isinstance(devices, HostProcesses):
         kw = dict(width=width, compile_only=compile_only, pilot_fraction=pilot_fraction)
@@ -246,7 +299,11 @@ def run_lanes_with_stats(
     mesh = device_mesh(devices)
     L = int(np.shape(y0b)[0])
     ndev = 1 if mesh is None else mesh.devices.size
-    Lp = math.ceil(max(L, pad_to or 0) / ndev) * ndev
+    platform = (list(devices)[0] if devices else jax.local_devices()[0]).platform
+    on_gpu = platform in ("gpu", "cuda", "rocm")
+    use_kernel = engine == "kernel" or (engine == "auto" and on_gpu and kernel_supported(cfg.solver))
+    per = ndev * (BLOCK if use_kernel else 1)  # the kernel's programs take whole blocks of lanes
+    Lp = math.ceil(max(L, pad_to or 0) / per) * per
     pb_np = jax.tree_util.tree_map(lambda x: pad_lanes(np.asarray(x), Lp), pb)
     y0_np = pad_lanes(np.asarray(y0b, dtype=np.float64), Lp)
     dt = np.dtype(cfg.dtype)  # the pool's arithmetic; the Lyapunov stage below stays float64
@@ -276,7 +333,6 @@ def run_lanes_with_stats(
     frac = float(pilot_fraction) if pilot_fraction and Lloc > Wd else np.inf
     # kernel boundaries pay on CPU (`jaxcelt.ensemble.kernel_boundary`); on an accelerator a
     # conditional costs a device-to-host sync per stage, so none there
-    platform = (list(devices)[0] if devices else jax.local_devices()[0]).platform
     opaque_true = jnp.asarray(True) if platform == "cpu" else None
     if is_wide_pool(platform, Wd):  # the contact law's form for wide batches (vectorised logarithm)
         nocfg = dataclasses.replace(nocfg, contact_law=get_contact_law(nocfg.contact_law).wide_batch())
@@ -285,19 +341,34 @@ def run_lanes_with_stats(
     # The pool's program and the Lyapunov stage's are traced here, one after the other, and
     # compiled by XLA on worker threads at the same time (XLA releases the GIL while compiling); both
     # are then called as compiled programs. Later chunks of the same shapes find them in JAX's caches.
-    pool_args = (pb_p, y0_np[pos_lane].astype(dt), live, jnp.asarray(frac), transient, tols, nocfg, Wd, mesh, vary,
-                 opaque_true, (int(drain_factor), int(min_drain_width)))  # fmt: skip
-    with gc_paused():
-        pool_lowered = _pool_chunk.lower(*pool_args)
-    pool_compiled = compile_later(functools.partial(pool_lowered.compile, pool_compiler_options(platform, Wd)))
+    if use_kernel:
+        leaves, treedef = jax.tree_util.tree_flatten(pb_p)
+        p_const = jax.tree_util.tree_unflatten(treedef, [x[0].item() for x in leaves])
+        kcfg = dataclasses.replace(static_cfg, lyapunov_periods=0)
+        pool_args = (tuple(x for x, v in zip(leaves, vary) if v), y0_np[pos_lane].astype(dt), live, transient, tols,
+                     p_const, kcfg, vary, mesh, not on_gpu)  # fmt: skip
+        with gc_paused():
+            pool_lowered = _kernel_chunk.lower(*pool_args)
+        pool_compiled = compile_later(pool_lowered.compile)
+    else:
+        pool_args = (pb_p, y0_np[pos_lane].astype(dt), live, jnp.asarray(frac), transient, tols, nocfg, Wd, mesh, vary,
+                     opaque_true, (int(drain_factor), int(min_drain_width)))  # fmt: skip
+        with gc_paused():
+            pool_lowered = _pool_chunk.lower(*pool_args)
+        pool_compiled = compile_later(functools.partial(pool_lowered.compile, pool_compiler_options(platform, Wd)))
     lyap_compiled = None
     if cfg.lyapunov_periods > 0 and not compile_only:
         example = (jax.tree_util.tree_map(lambda x: x[:1].repeat(G, 0), pb_np), np.zeros((G, 13)), np.zeros(G))
         with gc_paused():
             lyap_lowered = lyap_fn.lower(*example, static_cfg, mesh)
         lyap_compiled = compile_later(lyap_lowered.compile)
-    out, iters, slot_steps = pool_compiled.result()(*pool_args)
-    stats = PoolStats(iterations=int(np.asarray(iters).max()), slot_steps=int(np.sum(np.asarray(slot_steps))), width=Wd)
+    if use_kernel:
+        out, lane_iters = pool_compiled.result()(*pool_args)
+        lane_iters = np.asarray(lane_iters)  # each lane: its block's loop iterations
+        stats = PoolStats(iterations=int(lane_iters.max()), slot_steps=int(lane_iters.sum()), width=BLOCK)
+    else:
+        out, iters, slot_steps = pool_compiled.result()(*pool_args)
+        stats = PoolStats(iterations=int(np.asarray(iters).max()), slot_steps=int(np.sum(np.asarray(slot_steps))), width=Wd)
     out = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(out))
     inv = np.empty_like(pos_lane)
     inv[pos_lane] = np.arange(Lp)
@@ -340,6 +411,7 @@ def run_lanes(
     compile_only: bool = False,
     varying: Sequence[str] = (),
     pilot_fraction: float = PILOT_FRACTION,
+    engine: str = "auto",
 ) -> dict[str, np.ndarray]:
     """Run one chunk of lanes (batched params and y0 with a leading lane axis) and return numpy arrays.
 
@@ -368,7 +440,7 @@ def run_lanes(
     """
     out, stats = run_lanes_with_stats(
         pb, y0b, cfg, devices=devices, pad_to=pad_to, width=width, compile_only=compile_only, varying=varying,
-        pilot_fraction=pilot_fraction,
+        pilot_fraction=pilot_fraction, engine=engine,
     )  # fmt: skip
     L = len(out["status"])
     out["pool_iterations"] = np.full(L, stats.iterations)  # the busiest device's loop iterations
