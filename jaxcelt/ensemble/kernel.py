@@ -37,6 +37,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .._diffrax_adapter import t1_clip_floor
 from .._types import Array
 from ..contact import get_contact_law
 from ..model import vector_field_and_normal
@@ -104,8 +105,20 @@ class _Segment:
         ex_pv = tuple(one for _ in range(nvary))
         self.rhs = blockwise(lambda t, y, pv: vector_field_and_normal(t, y, params_of(pv), law), one,
                              np.zeros(13, self.dtype), ex_pv)  # fmt: skip
+        self.omega_of = lambda pv: params_of(pv).omega_pi
+
+    def field_time(self, t: Array, pv: tuple[Array, ...]) -> Array:
+        """The time the field is evaluated at, in the state's dtype. Times are float64 in the kernel;
+        a float32 field gets t - n 2 pi/omega_pi (n = floor(t omega_pi/2 pi)), the same forcing phase
+        (the field depends on t through sin(omega_pi t) alone), resolved to float32's precision of a
+        period rather than of t itself (at t = 120 s float32 steps in 7.6 us)."""
+        if self.dtype == np.float64:
+            return t
+        period = (2 * np.pi) / jnp.asarray(self.omega_of(pv), jnp.float64)
+        return (t - jnp.floor(t / period) * period).astype(self.dtype)
 
     def field(self, t: Array, y: list[Array], pv: tuple[Array, ...]) -> tuple[list[Array], Array, Array]:
+        t = self.field_time(t, pv)
         yo = np.empty(13, dtype=object)
         for m, e in enumerate(y):
             yo[m] = e
@@ -117,23 +130,24 @@ class _Segment:
         dt_ = self.dtype
         y0, f0, t0 = s["y"], s["f"], s["tprev"]
         act = (s["code"] == 0) & (s["num_steps"] < self.max_steps) & (t0 < target)
-        dt = s["tnext"] - t0
+        dt = s["tnext"] - t0  # times in float64 (`field_time`)
+        dts = dt.astype(dt_)
         ns = len(self.c)
-        zero = jnp.zeros_like(t0)
-        ks = [[f * dt for f in f0]] + [[zero] * 13 for _ in range(ns)]
+        zero = jnp.zeros(t0.shape, dt_)
+        ks = [[f * dts for f in f0]] + [[zero] * 13 for _ in range(ns)]
 
-        def pick(i, col):  # col[i] for a traced stage index: a chain of scalar selects (no constant arrays in a kernel)
-            out = jnp.asarray(col[-1], dt_)
+        def pick(i, col, dtype=dt_):  # col[i] for a traced stage index: a chain of scalar selects (no constant arrays in a kernel)
+            out = jnp.asarray(col[-1], dtype)
             for r in range(len(col) - 2, -1, -1):
-                out = jnp.where(i == r, jnp.asarray(col[r], dt_), out)
+                out = jnp.where(i == r, jnp.asarray(col[r], dtype), out)
             return out
 
         def stage(i, carry):
             ks, _, _, _, _ = carry
             coef = [pick(i, [float(x) for x in self.a[:, j]]) for j in range(ns)]
             yi = [y0[m] + sum(coef[j] * ks[j][m] for j in range(ns) if self.a[:, j].any()) for m in range(13)]
-            fi, N, den = self.field(t0 + pick(i, self.c) * dt, yi, pv)
-            new = [f * dt for f in fi]
+            fi, N, den = self.field(t0 + pick(i, self.c, jnp.float64) * dt, yi, pv)
+            new = [f * dts for f in fi]
             ks = [ks[0]] + [[jnp.where(i + 1 == j, new[m], ks[j][m]) for m in range(13)] for j in range(1, ns + 1)]
             return ks, yi, fi, N, den
 
@@ -155,10 +169,10 @@ class _Segment:
             jnp.where(keep, self.fmax, self.safety).astype(dt_),
         )
         tprev = jnp.where(keep, s["tnext"], t0)
-        tnext = tprev + dt * factor
+        tnext = tprev + dt * factor.astype(jnp.float64)
         tnext = jnp.where(tprev >= target, tnext, jnp.minimum(tnext, target))  # onto the section time
         span = tnext - tprev
-        small = ~keep & ~((span >= MIN_STEP_ULPS * jnp.abs(tprev) * np.finfo(dt_).eps) & (span > 0))
+        small = ~keep & ~((span >= MIN_STEP_ULPS * jnp.abs(tprev) * np.finfo(np.float64).eps) & (span > 0))
         tprev = jnp.minimum(tprev, t1)  # diffeqsolve's end-of-interval rounding
         tnext = jnp.where(tnext > floor, jnp.where(keep, t1, tprev + 0.5 * (t1 - tprev)), tnext)
         kind = jnp.where(den <= 0, 3, jnp.where(y1[8] <= 0, 2, jnp.where(N <= 0, 1, 0))).astype(jnp.int32)
@@ -243,19 +257,22 @@ def run_kernel_lanes(
 ) -> tuple[dict[str, Array], Array, Array]:
     """Every lane from its start (`jaxcelt.ensemble.start_lanes`' lane states) to its last section
     time: (outputs as `jaxcelt.ensemble.lane_outputs` gives them, the samples (L, S, 13), the
-    kernel's loop iterations per lane summed over the calls)."""
+    kernel's loop iterations per lane summed over the calls). ``ts_all``: (L, S) section times,
+    float64 whatever the state's dtype (the kernel's times are float64)."""
     dt_ = seg.dtype
+    f64 = jnp.float64
     L, S = ts_all.shape
+    ts_all = ts_all.astype(f64)
     st = lanes0.step_state
     code = jnp.where(lanes0.done & (st.first_invalid_kind > 0) & seg.stop_on_invalid, 2, 0).astype(jnp.int32)
     s = dict(
         y=[lanes0.y[:, m] for m in range(13)],
         f=[st.f[:, m] for m in range(13)],
-        tprev=lanes0.tprev,
-        tnext=lanes0.tnext,
+        tprev=lanes0.tprev.astype(f64),
+        tnext=lanes0.tnext.astype(f64),
         num_steps=lanes0.num_steps.astype(jnp.int32),
         code=code,
-        first_invalid_t=st.first_invalid_t,
+        first_invalid_t=st.first_invalid_t.astype(f64),
         first_invalid_kind=st.first_invalid_kind.astype(jnp.int32),
         min_N=st.min_N,
         min_n3=st.min_n3,
@@ -263,7 +280,8 @@ def run_kernel_lanes(
     # padding lanes (done at the start without a reason) are parked: a step budget of zero
     parked = lanes0.done & (code == 0)
     s["num_steps"] = jnp.where(parked, seg.max_steps, s["num_steps"])
-    t1, floor = lanes0.t1, lanes0.floor
+    t1 = ts_all[:, -1]
+    floor = jax.vmap(t1_clip_floor)(t1)
 
     def call(flat, target):
         return seg(flat, target, t1, floor, pv, interpret)

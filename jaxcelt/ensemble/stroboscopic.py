@@ -235,7 +235,10 @@ def _kernel_chunk(
         t0 = jnp.asarray(cfg.t0, cfg.dtype)
         lanes, _ = start_lanes(stepper, tuple(pv), params_of, y0b, ts_all, live, tols, t0)
         seg = make_segment(cfg, params_of, len(pv))
-        out, samples, iters = run_kernel_lanes(seg, lanes, tuple(pv), ts_all, interpret)
+        # the kernel's times are float64 (`jaxcelt.ensemble.kernel`): section times from the lanes' omega_pi
+        ts64 = _section_times(jax.tree_util.tree_map(lambda x: x.astype(jnp.float64), pb), transient, cfg)
+        out, samples, iters = run_kernel_lanes(seg, lanes, tuple(pv), ts64, interpret)
+        ts_all = ts64
         out = dict(out, samples=samples, t_samples=ts_all)
         out.update(jax.vmap(_extras)(samples, pb))
         return out, iters
