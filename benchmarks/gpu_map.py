@@ -111,11 +111,7 @@ def main() -> int:
     t_compile = time.perf_counter() - t
     print(f"compile {t_compile:.1f} s", flush=True)
     t = time.perf_counter()
-    if a.engine == "auto":
-        ds = jc.parameter_map(p, x=("omega_pi", xs), y=("q_pi", ys), chunk_size=cs, width=W, **kw)
-    else:  # the engine forced: the same lanes through run_lanes (no dataset)
-        ds = _as_map(run_lanes(pb_all(p, xs, ys), np.tile(np.asarray(jc.initial_state(p)), (L, 1)), cfg, width=W,
-                               varying=("omega_pi", "q_pi"), engine=a.engine), a.nx, a.ny)  # fmt: skip
+    ds = jc.parameter_map(p, x=("omega_pi", xs), y=("q_pi", ys), chunk_size=cs, width=W, engine=a.engine, **kw)
     t_run = time.perf_counter() - t
     steps = ds["num_steps"].values
     status = ds["status"].values
@@ -161,16 +157,6 @@ def pb_all(p, xs, ys):
 
     lane_x, lane_y = np.repeat(xs, len(ys)), np.tile(ys, len(xs))
     return eqx.tree_at(lambda q: q.q_pi, lanes_params(p, "omega_pi", lane_x), jnp.asarray(lane_y))
-
-
-def _as_map(out: dict, nx: int, ny: int):
-    import xarray as xr
-
-    from jaxcelt.regimes import classify
-
-    lab = classify(out["samples"], out["status"], out["valid"], out["r_O"])
-    fields = dict(num_steps=out["num_steps"], status=out["status"], regime=lab["regime"], period=lab["period"])
-    return xr.Dataset({k: (("x", "y"), np.asarray(v).reshape(nx, ny)) for k, v in fields.items()})
 
 
 def check(a) -> dict:

@@ -104,7 +104,8 @@ from .diagnostics import centre_position
 from .ensemble import DEFAULT_WIDTH as DEFAULT_WIDTH
 from .ensemble import MIN_DRAIN_WIDTH as MIN_DRAIN_WIDTH
 from .ensemble import PILOT_FRACTION as PILOT_FRACTION
-from .ensemble.stroboscopic import SweepConfig, lanes_params, run_lanes, run_lanes_with_stats
+from .ensemble.kernel import kernel_supported
+from .ensemble.stroboscopic import ENGINES, SweepConfig, lanes_params, run_lanes, run_lanes_with_stats
 from .ensemble.stroboscopic import _erk_tableau as _erk_tableau  # noqa: F401  (tests)
 from .params import PARAM_NAMES, CeltParams
 from .solve import DEFAULT_SOLVER, simulate
@@ -251,6 +252,7 @@ def _run_chunked(
     width: int | None,
     varying: Sequence[str],
     progress: bool,
+    engine: str = "auto",
     desc: str,
     on_chunk: Callable[[int, dict[str, np.ndarray]], None] | None,
     skip: Callable[[int], bool] = lambda ci: False,
@@ -272,7 +274,9 @@ def _run_chunked(
             continue
         pb = jax.tree_util.tree_map(lambda x, idx=idx: np.asarray(x)[idx], pb_all)
         t_start = time.perf_counter()
-        res = run_lanes(pb, lane_y0[idx], cfg, devices=devices, pad_to=pad_to, width=width, varying=varying)
+        res = run_lanes(
+            pb, lane_y0[idx], cfg, devices=devices, pad_to=pad_to, width=width, varying=varying, engine=engine
+        )
         res["_seconds"] = np.full(len(idx), (time.perf_counter() - t_start) / len(idx))
         results[ci] = res
         if writer is not None:
@@ -341,6 +345,7 @@ def _run_batch(
     width: int | None,
     out: str | None,
     progress: bool,
+    engine: str = "auto",
     on_chunk: Callable[[int, dict[str, np.ndarray]], None] | None,
     desc: str,
 ) -> tuple[dict[str, np.ndarray] | None, Any]:
@@ -349,6 +354,10 @@ def _run_batch(
     other than 0 of a multi-process run, the `jaxcelt.dataset.SweepWriter` or None)."""
     if not np.all(np.asarray(pb_all.omega_pi) > 0):
         raise ValueError("stroboscopic sampling needs omega_pi > 0 in every lane")
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
+    if engine == "kernel" and not kernel_supported(cfg.solver):
+        raise ValueError(f"engine='kernel' needs an explicit FSAL Runge-Kutta solver, got {type(cfg.solver).__name__}")
     L = lane_y0.shape[0]
     order = np.arange(L)
     if sort_by_cost:
@@ -374,6 +383,7 @@ def _run_batch(
     lanes = _run_all(
         pb_all, lane_y0, cfg, chunks, cs, writer, done,
         devices=devices, width=width, varying=tuple(names), progress=progress, desc=desc, on_chunk=on_chunk,
+        engine=engine,
     )  # fmt: skip
     return lanes, writer
 
@@ -405,6 +415,7 @@ def sweep_lanes(
     stop_on_invalid: bool = False,
     dtype: Any = "float64",
     width: int | None = None,
+    engine: str = "auto",
     devices: Sequence[Any] | None = None,
     out: str | None = None,
     progress: bool = False,
@@ -451,7 +462,7 @@ def sweep_lanes(
     lanes_out, writer = _run_batch(
         _batched_params(params, vals), np.ascontiguousarray(y), cfg, params=params, names=names,
         lane_values=lane_values, n_starts=1, chunk_size=chunk_size, sort_by_cost=sort_by_cost, devices=devices,
-        width=width, out=out, progress=progress, on_chunk=on_chunk, desc="lanes",
+        width=width, out=out, progress=progress, on_chunk=on_chunk, desc="lanes", engine=engine,
     )  # fmt: skip
     if lanes_out is None:
         return None
@@ -483,6 +494,7 @@ def sweep(
     stop_on_invalid: bool = False,
     dtype: Any = "float64",
     width: int | None = None,
+    engine: str = "auto",
     devices: Sequence[Any] | None = None,
     out: str | None = None,
     progress: bool = False,
@@ -512,6 +524,11 @@ def sweep(
             use rtol >= 1e-6; results come back as float64 arrays, the Lyapunov stage runs
             in float64). Part of the dataset's fingerprint.
         width: batch slots per device of the pool (default `DEFAULT_WIDTH`).
+        engine: how lanes are stepped (`jaxcelt.ensemble.ENGINES`): ``"auto"`` (default) runs
+            them in the lane kernel on a GPU (`jaxcelt.ensemble.kernel`: one thread per lane,
+            explicit FSAL solvers) and in the lane pool elsewhere; ``"pool"`` or ``"kernel"`` forces
+            one (the kernel off a GPU runs interpreted: slow, for tests). Both take the same steps
+            up to rounding.
         devices: devices to shard each chunk over (default all local devices), or a
             `jaxcelt.HostProcesses`: worker processes, one pinned to each CPU core with one
             device each (`jaxcelt.ensemble.processes`).
@@ -544,7 +561,7 @@ def sweep(
     lanes, writer = _run_batch(
         lanes_params(params, name, lane_values), lane_y0, cfg, params=params, names=[name], lane_values=lane_values,
         n_starts=K, chunk_size=chunk_size, sort_by_cost=sort_by_cost, devices=devices, width=width, out=out,
-        progress=progress, on_chunk=on_chunk, desc=f"sweep {name}",
+        progress=progress, on_chunk=on_chunk, desc=f"sweep {name}", engine=engine,
     )  # fmt: skip
     if lanes is None:  # a process other than 0 of a multi-process sweep: its chunks are on disk
         return None
@@ -612,6 +629,7 @@ def parameter_map(
     stop_on_invalid: bool = False,
     dtype: Any = "float64",
     width: int | None = None,
+    engine: str = "auto",
     devices: Sequence[Any] | None = None,
     out: str | None = None,
     progress: bool = False,
@@ -664,6 +682,7 @@ def parameter_map(
         _batched_params(params, {xn: lane_x, yn: lane_y}), lane_y0, cfg, params=params, names=[xn, yn],
         lane_values=np.stack([lane_x, lane_y], axis=1), n_starts=K, chunk_size=chunk_size,
         sort_by_cost=sort_by_cost, devices=devices, width=width, out=out, progress=progress, on_chunk=on_chunk,
+        engine=engine,
         desc=f"map {xn} x {yn}",
     )  # fmt: skip
     if lanes is None:  # a process other than 0 of a multi-process map

@@ -7,13 +7,18 @@
   while loop, with `PoolStats`;
 * `shard`: lanes over devices;
 * `processes`: `HostProcesses`, lanes over single-device worker processes, one per CPU core;
+* `kernel`: the lane kernel, every lane of a chunk stepped inside one GPU kernel, one thread
+  per lane (Pallas, Triton backend), with the field re-expressed on lane blocks by `soa`;
 * `stroboscopic`: `run_lanes`, one chunk of lanes sampled at the forcing's section times
-  (`SweepConfig`), sharded over devices, with the optional Lyapunov stage.
+  (`SweepConfig`), sharded over devices, through the pool or the kernel (`ENGINES`), with the
+  optional Lyapunov stage.
 
 The user-facing sweeps (`jaxcelt.sweep`: `bifurcation`, `parameter_map`, ...) are built on it.
 The diffrax internals it mirrors live in `jaxcelt._diffrax_adapter`.
 """
 
+from .kernel import BLOCK as BLOCK
+from .kernel import kernel_supported as kernel_supported
 from .lanes import LaneMonitor as LaneMonitor
 from .lanes import LaneOutputs as LaneOutputs
 from .lanes import LaneState as LaneState
@@ -30,6 +35,7 @@ from .processes import HostProcesses as HostProcesses
 from .shard import device_mesh as device_mesh
 from .shard import pad_lanes as pad_lanes
 from .shard import shard_lanes as shard_lanes
+from .soa import blockwise as blockwise
 from .stepper import AbstractLaneStepper as AbstractLaneStepper
 from .stepper import DiffraxStepper as DiffraxStepper
 from .stepper import DiffraxStepState as DiffraxStepState
@@ -38,6 +44,7 @@ from .stepper import FusedStepState as FusedStepState
 from .stepper import erk_tableau as erk_tableau
 from .stepper import kernel_boundary as kernel_boundary
 from .stepper import make_stepper as make_stepper
+from .stroboscopic import ENGINES as ENGINES
 from .stroboscopic import SweepConfig as SweepConfig
 from .stroboscopic import lanes_params as lanes_params
 from .stroboscopic import run_lanes as run_lanes
