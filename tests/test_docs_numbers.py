@@ -578,3 +578,45 @@ def test_map_window_check_from_json():
     assert lo["lyapunov_40"] == {"uncertain": s["low_lanes"]}
     for quote in quotes:
         assert quote in text, quote
+
+
+def test_gpu_kernel_table_from_json():
+    """The lane kernel's GPU table and bullets in the engine's docs against docs/performance/gpu_map_kernel.json
+    (benchmarks/gpu_map.py; times to 0.1 s, counts with a space as thousands separator)."""
+    text = _text("docs/bifurcation/README.md")
+    flat = " ".join(text.split())
+    d = _json("docs/performance/gpu_map_kernel.json")
+
+    def sp(n):
+        return f"{n:,}".replace(",", " ")
+
+    maps = [r for r in d["session_2"] if "grid" in r]
+    f64 = next(r for r in maps if r["dtype"] == "float64")
+    f32 = next(r for r in maps if r["dtype"] == "float32")
+    earlier = next(r for r in d["session_1"] if "grid" in r and r["dtype"] == "float64")
+    for r in (f64, f32, earlier):
+        st = r["status_counts"]
+        row = (f"{r['compile_s']:.1f} s", f"{r['run_s']:.1f} s", sp(round(r["lanes_per_s"])),
+               f"{r['steps_total'] / 1e10:.3f} × 10¹⁰", sp(round(r["steps_median"])),
+               f"{sp(st['0'])} / {sp(st['1'])} / {sp(st['2'])}")  # fmt: skip
+        line = next((ln for ln in text.splitlines() if f"| {r['dtype']}, " in ln and row[0] in ln), "")
+        for q in row:
+            assert q in line, (q, line)
+    assert earlier["steps_total"] == f64["steps_total"]  # "took the same steps"
+    comp = next(r["comparison"] for r in d["session_2"] if "comparison" in r)
+    chk = next(r["check"] for r in d["session_1"] if "check" in r)["float64"]
+    quotes = [
+        f"**Target met: {f64['run_s']:.1f} s and {earlier['run_s']:.1f} s**",
+        f"{sp(f64['status_counts']['1'])} sticking lanes stop at max_steps",
+        f"all {chk['same_status']} lanes had the same status and the same step count",
+        f"within {chk['max_sample_difference_rel']:.1e}",
+        f"is {f64['run_s'] / f32['run_s']:.1f}× faster",
+        f"status in {100 * comp['same_status_fraction']:.1f} % of the cells and its category in "
+        f"{100 * comp['same_category_fraction']:.1f} %",
+        f"{sp(f64['regime_counts']['period 3-16'])} cells in float64, {f32['regime_counts']['period 3-16']} in float32",
+    ]
+    broken = next(r for r in d["session_1"] if "grid" in r and r["dtype"] == "float32")  # times still float32
+    quotes.append(f"collapsed the step of {sp(broken['status_counts']['3'])} of its {sp(broken['lanes'])} lanes")
+    assert chk["same_steps"] == chk["same_status"] == 64
+    for q in quotes:
+        assert q in flat, q
