@@ -615,6 +615,13 @@ def test_gpu_kernel_table_from_json():
         f"{100 * comp['same_category_fraction']:.1f} %",
         f"{sp(f64['regime_counts']['period 3-16'])} cells in float64, {f32['regime_counts']['period 3-16']} in float32",
     ]
+    side = {r["engine"]: r for r in d["session_3"] if "grid" in r}  # equal work, one machine
+    k, p = side["auto"], side["pool"]
+    assert k["engine_used"] == "kernel" and p["engine_used"] == "pool" and k["periods"] == p["periods"]
+    quotes += [
+        f"the kernel {k['run_s']:.1f} s, the pool {p['run_s']:.1f} s (**{p['run_s'] / k['run_s']:.1f}×**)",
+        f"({k['compile_s']:.1f} s and {p['compile_s']:.1f} s); {sp(k['steps_total'])} against {sp(p['steps_total'])} lane-steps",
+    ]
     broken = next(r for r in d["session_1"] if "grid" in r and r["dtype"] == "float32")  # times still float32
     quotes.append(f"collapsed the step of {sp(broken['status_counts']['3'])} of its {sp(broken['lanes'])} lanes")
     assert chk["same_steps"] == chk["same_status"] == 64

@@ -67,9 +67,8 @@ def _pallas():
     return pl
 
 
-def _compiler_params(interpret: bool) -> Any:
-    if interpret:
-        return None
+def _triton_params() -> Any:
+    """One warp per program (`BLOCK` = 32 lanes, one per thread); no software pipelining (no loads in the loop)."""
     from jax.experimental.pallas import triton as plt
 
     return plt.CompilerParams(num_warps=1, num_stages=1)
@@ -84,7 +83,6 @@ class _Segment:
         if tab is None:
             raise ValueError(f"the lane kernel needs an explicit FSAL Runge-Kutta solver, got {type(cfg.solver).__name__}")
         self.dtype = np.dtype(dtype)
-        self.n = 13
         self.c = [float(x) for x in np.asarray(tab.c, dtype=float)]
         ns = len(self.c)  # stages after the first (FSAL) one
         a = np.zeros((ns, ns + 1))
@@ -126,7 +124,8 @@ class _Segment:
         full = lambda e: e if np.ndim(e) == 1 else jnp.full(t.shape, np.asarray(e), self.dtype)  # noqa: E731
         return [full(e) for e in f], full(N[()]), full(den[()])
 
-    def step(self, s: dict, target: Array, t1: Array, floor: Array, pv: tuple[Array, ...]) -> dict:
+    def step(self, s: dict, target: Array, t1: Array, floor: Array, pv: tuple[Array, ...]) -> tuple[dict, Array]:
+        """One step of every lane of the block that is still short of ``target``: (the new state, which lanes stepped)."""
         dt_ = self.dtype
         y0, f0, t0 = s["y"], s["f"], s["tprev"]
         act = (s["code"] == 0) & (s["num_steps"] < self.max_steps) & (t0 < target)
@@ -224,7 +223,7 @@ class _Segment:
         spec = pl.BlockSpec((BLOCK,), lambda i: (i,))
         args = list(flat) + [target, t1, floor] + list(pv)
         out_shape = [jax.ShapeDtypeStruct((L,), x.dtype) for x in flat] + [jax.ShapeDtypeStruct((L,), jnp.int32)]
-        kw = {} if interpret else {"compiler_params": _compiler_params(False)}
+        kw = {} if interpret else {"compiler_params": _triton_params()}
         out = pl.pallas_call(
             self.kernel, out_shape=out_shape, grid=(L // BLOCK,), in_specs=[spec] * len(args),
             out_specs=[spec] * len(out_shape), interpret=interpret, name="jaxcelt_lanes", **kw,
