@@ -627,3 +627,5 @@ def test_gpu_kernel_table_from_json():
     assert chk["same_steps"] == chk["same_status"] == 64
     for q in quotes:
         assert q in flat, q
+    for path in ("README.md", "docs/map/README.md", "docs/performance.md"):  # the headline number elsewhere
+        assert f"{f64['run_s']:.1f} s" in _text(path), path
