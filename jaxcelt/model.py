@@ -40,6 +40,7 @@ __all__ = [
     "vector_field",
     "vector_field_and_normal",
     "split_state",
+    "field_time",
     "STATE_NAMES",
 ]
 
@@ -111,6 +112,22 @@ def patch_frame(n: Vec3) -> tuple[Vec3, Vec3]:
     e1 = jnp.array([1.0, 0.0, 0.0], dtype=n.dtype)
     e_x = (e1 - n[0] * n) / jnp.sqrt(1.0 - n[0] ** 2)
     return e_x, cross3(n, e_x)
+
+
+def field_time(t: ScalarLike, omega_pi: ScalarLike, dtype, offset: ScalarLike = 0.0):
+    """The time to evaluate the field at for t + ``offset``, in ``dtype`` (the state's).
+
+    float64: t + offset, unchanged. Otherwise the same forcing phase one period from 0:
+    (t - n 2 pi/omega_pi) + offset with n = floor(t omega_pi/2 pi), computed in float64 and rounded
+    once. The field depends on t only through sin(omega_pi t) (`base_velocity`), so this is the same
+    field, with the stage times resolved to float32's precision of a period rather than of t itself:
+    at t = 120 s float32 times are 7.6 us apart, and stage times rounded that coarsely make the error
+    estimate reject step after step until the step size collapses."""
+    if jnp.dtype(dtype) == jnp.float64:
+        return t + offset if not (isinstance(offset, float) and offset == 0.0) else t
+    t64 = jnp.asarray(t, jnp.float64)
+    period = (2 * jnp.pi) / jnp.asarray(omega_pi, jnp.float64)
+    return ((t64 - jnp.floor(t64 / period) * period) + jnp.asarray(offset, jnp.float64)).astype(dtype)
 
 
 def base_velocity(t: ScalarLike, frame: Frame, p: CeltParams) -> Vec3:

@@ -520,9 +520,13 @@ def sweep(
         stop_on_invalid: end each lane at its first invalid state (lift-off, n3 <= 0):
             status 2, samples after the stop inf, no Lyapunov exponent. Default False (the
             model is integrated on, validity reported), as in `jaxcelt.simulate`.
-        dtype: the pool's arithmetic, ``"float64"`` (default) or ``"float32"`` (faster on GPUs;
+        dtype: the lanes' arithmetic, ``"float64"`` (default) or ``"float32"`` (faster on GPUs;
             use rtol >= 1e-6; results come back as float64 arrays, the Lyapunov stage runs
-            in float64). Part of the dataset's fingerprint.
+            in float64). With the explicit solvers' fused step and in the lane kernel the times
+            stay float64 and the field gets the forcing phase from one period
+            (`jaxcelt.model.field_time`); with other solvers float32 lanes step in float32
+            time, and a step below ~10 ULPs of t ends a lane (status 3). Part of the
+            dataset's fingerprint.
         width: batch slots per device of the pool (default `DEFAULT_WIDTH`).
         engine: how lanes are stepped (`jaxcelt.ensemble.ENGINES`): ``"auto"`` (default) runs
             them in the lane kernel on a GPU (`jaxcelt.ensemble.kernel`: one thread per lane,

@@ -565,6 +565,24 @@ def test_float32_pool_agrees_with_float64(paper_params):
         bifurcation(paper_params, [15.0], dtype="float16", **kw)
 
 
+def test_float32_pool_over_300_periods(paper_params):
+    """float32 lanes late in time: over 300 periods (t up to 126 s, where float32 times are 7.6e-6 s
+    apart) a float32 pool gives every lane the float64 pool's status. With float32 times every one
+    of these lanes ended with a collapsed step (status 3); the pool now steps float32 lanes in float64
+    time with the forcing phase from one period (`jaxcelt.ensemble.float64_times`,
+    `jaxcelt.model.field_time`). Statuses only: over 300 periods the chaotic lanes' samples part."""
+    om = np.repeat([15.0, 17.5, 20.0], 2)
+    q = np.tile([0.04, 0.06], 3)
+    kw = dict(transient_periods=270, sample_periods=30, stop_on_invalid=True, rtol=1e-6, atol=1e-8)
+    from jaxcelt.sweep import sweep_lanes
+
+    r64 = sweep_lanes(paper_params, {"omega_pi": om, "q_pi": q}, **kw)
+    r32 = sweep_lanes(paper_params, {"omega_pi": om, "q_pi": q}, dtype="float32", **kw)
+    np.testing.assert_array_equal(r32["status"].values, r64["status"].values)
+    assert np.sum(r32["status"].values == 0) >= 2  # lanes that run to the end, not only invalid ones
+    assert np.all(np.isfinite(r32["section"].values[r32["status"].values == 0]))
+
+
 def test_sweep_lanes_any_batch_equals_bifurcation(base, paper_params, tmp_path):
     """`sweep_lanes` over an arbitrary batch (omega_pi and q_pi drawn per lane, shuffled, plus one
     lane with another start): each lane equals the `bifurcation` lane with the same parameters and

@@ -40,7 +40,7 @@ import numpy as np
 from .._diffrax_adapter import t1_clip_floor
 from .._types import Array
 from ..contact import get_contact_law
-from ..model import vector_field_and_normal
+from ..model import field_time, vector_field_and_normal
 from ..solve import MIN_STEP_ULPS
 from .soa import blockwise
 from .stepper import erk_tableau
@@ -106,14 +106,9 @@ class _Segment:
         self.omega_of = lambda pv: params_of(pv).omega_pi
 
     def field_time(self, t: Array, pv: tuple[Array, ...]) -> Array:
-        """The time the field is evaluated at, in the state's dtype. Times are float64 in the kernel;
-        a float32 field gets t - n 2 pi/omega_pi (n = floor(t omega_pi/2 pi)), the same forcing phase
-        (the field depends on t through sin(omega_pi t) alone), resolved to float32's precision of a
-        period rather than of t itself (at t = 120 s float32 steps in 7.6 us)."""
-        if self.dtype == np.float64:
-            return t
-        period = (2 * np.pi) / jnp.asarray(self.omega_of(pv), jnp.float64)
-        return (t - jnp.floor(t / period) * period).astype(self.dtype)
+        """The time the field is evaluated at, in the state's dtype (`jaxcelt.model.field_time`): the
+        kernel's times are float64; a float32 field gets the forcing phase from one period."""
+        return field_time(t, self.omega_of(pv), self.dtype)
 
     def field(self, t: Array, y: list[Array], pv: tuple[Array, ...]) -> tuple[list[Array], Array, Array]:
         t = self.field_time(t, pv)

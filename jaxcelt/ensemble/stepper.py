@@ -38,7 +38,7 @@ import numpy as np
 from .._diffrax_adapter import clip_to_end, loop_init, loop_step, t1_clip_floor, wrap_term
 from .._types import Array
 from ..contact import AbstractContactLaw, get_contact_law
-from ..model import vector_field_and_normal
+from ..model import field_time, vector_field_and_normal
 from ..params import CeltParams
 from ..solve import MinStepController, MonitoredSolver, _Field, _fill_implicit_tols, invalid_kind, step_too_small
 from .lanes import LaneMonitor, LaneState
@@ -51,6 +51,7 @@ __all__ = [
     "FusedStepState",
     "make_stepper",
     "erk_tableau",
+    "float64_times",
     "kernel_boundary",
 ]
 
@@ -257,11 +258,15 @@ class FusedERKStepper(AbstractLaneStepper):
         boundary = (lambda x: x) if self.opaque_true is None else kernel_boundary(jnp.asarray(self.opaque_true))
         t1, y0, t0 = lane.t1, lane.y, lane.tprev
         dt = lane.tnext - t0
-        ks = [st.f * dt]
+        dts = dt.astype(y0.dtype)  # float32 lanes step in float64 time (`float64_times`); float64: no-op
+        ks = [st.f * dts]
+        float64 = y0.dtype == jnp.float64
         for c, a in zip(np.asarray(tab.c, dtype=float).tolist(), tab.a_lower):
             yi = boundary(_combine(y0, a, ks))
-            fi, aux = vector_field_and_normal(t0 + c * dt, yi, p, self.law)
-            ks.append(fi * dt)
+            # float32 lanes: the forcing phase from one period, not from t (`jaxcelt.model.field_time`)
+            ti = t0 + c * dt if float64 else field_time(t0, p.omega_pi, y0.dtype, c * dt)
+            fi, aux = vector_field_and_normal(ti, yi, p, self.law)
+            ks.append(fi * dts)
         b = np.asarray(tab.b_sol, dtype=float)
         fsal_is_y1 = b[-1] == 0.0 and np.array_equal(np.asarray(tab.a_lower[-1], dtype=float), b[:-1])
         y1 = yi if fsal_is_y1 else _combine(y0, b, ks)
@@ -279,7 +284,7 @@ class FusedERKStepper(AbstractLaneStepper):
             jnp.where(keep, pid.factormax, pid.safety),
         )
         tprev = jnp.where(keep, lane.tnext, t0)
-        tnext = tprev + dt * factor
+        tnext = tprev + dt * factor.astype(dt.dtype)
         # section times: the accepted step's end *is* the sample when it lands on ts[k]
         S = ts.shape[0]
         hit, k = _section_hit(ts, lane.k, keep, tprev)
@@ -320,6 +325,22 @@ class FusedERKStepper(AbstractLaneStepper):
     def monitor(self, lane):
         st = lane.step_state
         return LaneMonitor(st.first_invalid_t, st.first_invalid_kind, st.min_N, jnp.arccos(jnp.clip(st.min_n3, -1, 1)))
+
+
+def float64_times(lanes: LaneState, t1: Array) -> LaneState:
+    """Lanes (a batch) with their times in float64 and the state as it is: how `FusedERKStepper` steps
+    float32 lanes. In float32 time a lane's steps cannot shrink below ~10 ULPs of t (7.6e-5 s at
+    t = 120 s, `jaxcelt.solve.step_too_small`), which a lane sticking to the base needs; with the
+    field's forcing phase taken from one period (`jaxcelt.model.field_time`) the stage times stay
+    exact too. ``t1``: the lanes' last section times in float64 (from float64 omega_pi)."""
+    f64 = jnp.float64
+    st = lanes.step_state
+    return eqx.tree_at(
+        lambda s: (s.tprev, s.tnext, s.t1, s.floor, s.step_state.first_invalid_t),
+        lanes,
+        (lanes.tprev.astype(f64), lanes.tnext.astype(f64), t1, jax.vmap(t1_clip_floor)(t1),
+         st.first_invalid_t.astype(f64)),
+    )  # fmt: skip
 
 
 def erk_tableau(solver: diffrax.AbstractSolver) -> Any:

@@ -43,7 +43,7 @@ from .pool import (
     start_lanes,
 )
 from .shard import device_mesh, pad_lanes, shard_lanes
-from .stepper import AbstractLaneStepper, erk_tableau, make_stepper
+from .stepper import AbstractLaneStepper, FusedERKStepper, erk_tableau, float64_times, make_stepper
 
 __all__ = ["SweepConfig", "lanes_params", "run_lanes", "run_lanes_with_stats", "ENGINES"]
 
@@ -70,7 +70,8 @@ class SweepConfig:
     stop_on_invalid: bool = False
     """end a lane at the first accepted step whose end state is invalid (status 2, later samples inf)"""
     dtype: str = "float64"
-    """"float64" (default) or "float32": the pool's arithmetic (the Lyapunov stage stays float64)"""
+    """"float64" (default) or "float32": the lanes' arithmetic (times stay float64 with an explicit FSAL
+    solver, `jaxcelt.ensemble.float64_times`; the Lyapunov stage stays float64)"""
 
     def __post_init__(self):
         if self.dtype not in ("float64", "float32"):
@@ -192,6 +193,10 @@ def _pool_chunk(
         ts_all = _section_times(pb, transient, cfg)
         t0 = jnp.asarray(cfg.t0, cfg.dtype)
         lanes, samples = start_lanes(stepper, pv_all, params_of, y0b, ts_all, live, tols, t0)
+        if isinstance(stepper, FusedERKStepper) and cfg.dtype != "float64":
+            # float32 lanes step in float64 time (`FusedERKStepper`): section times from float64 omega_pi
+            ts_all = _section_times(jax.tree_util.tree_map(lambda x: x.astype(jnp.float64), pb), transient, cfg)
+            lanes = float64_times(lanes, ts_all[:, -1])
         lanes, samples, stats = run_pool(
             stepper, lanes, samples, pv_all, params_of, ts_all, t0, width=width, pause_frac=pause_frac,
             drain_factor=drain[0], min_drain_width=drain[1],
