@@ -594,19 +594,25 @@ def test_gpu_kernel_table_from_json():
     f64 = next(r for r in maps if r["dtype"] == "float64")
     f32 = next(r for r in maps if r["dtype"] == "float32")
     earlier = next(r for r in d["session_1"] if "grid" in r and r["dtype"] == "float64")
-    for r in (f64, f32, earlier):
+    final = {r["dtype"]: r for r in d["session_4"] if "grid" in r}
+    for r in (f64, f32, earlier, final["float64"], final["float32"]):
         st = r["status_counts"]
         row = (f"{r['compile_s']:.1f} s", f"{r['run_s']:.1f} s", sp(round(r["lanes_per_s"])),
                f"{r['steps_total'] / 1e10:.3f} × 10¹⁰", sp(round(r["steps_median"])),
                f"{sp(st['0'])} / {sp(st['1'])} / {sp(st['2'])}")  # fmt: skip
-        line = next((ln for ln in text.splitlines() if f"| {r['dtype']}, " in ln and row[0] in ln), "")
+        key = f"| {r['compile_s']:.1f} s | {r['run_s']:.1f} s |"
+        rows = [ln.replace("**", "") for ln in text.splitlines()]  # bold run times
+        line = next((ln for ln in rows if f"| {r['dtype']}, " in ln and key in ln), "")
         for q in row:
             assert q in line, (q, line)
-    assert earlier["steps_total"] == f64["steps_total"]  # "took the same steps"
+    assert earlier["steps_total"] == f64["steps_total"] == final["float64"]["steps_total"]  # "the same number of lane-steps"
+    chk32 = next(r["check"] for r in d["session_4"] if "check" in r)["float32"]
     comp = next(r["comparison"] for r in d["session_2"] if "comparison" in r)
     chk = next(r["check"] for r in d["session_1"] if "check" in r)["float64"]
     quotes = [
-        f"**Target met: {f64['run_s']:.1f} s and {earlier['run_s']:.1f} s**",
+        f"**Target met: {f64['run_s']:.1f} s, {earlier['run_s']:.1f} s and {final['float64']['run_s']:.1f} s**",
+        f"64 of 64 the same status, step counts within {chk32['max_step_difference']} of each other, samples within "
+        f"{chk32['max_sample_difference_rel']:.1e}".replace("e-0", "e-"),
         f"{sp(f64['status_counts']['1'])} sticking lanes stop at max_steps",
         f"all {chk['same_status']} lanes had the same status and the same step count",
         f"within {chk['max_sample_difference_rel']:.1e}",
