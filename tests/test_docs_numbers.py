@@ -635,3 +635,20 @@ def test_gpu_kernel_table_from_json():
         assert q in flat, q
     for path in ("README.md", "docs/map/README.md", "docs/performance.md"):  # the headline number elsewhere
         assert f"{f64['run_s']:.1f} s" in _text(path), path
+
+
+def test_float32_periodic_check_from_json():
+    """The float32-vs-float64 periodic-cell check quoted in the engine's GPU section against
+    docs/performance/float32_periodic_check.json (scripts/float32_periodic_check.py)."""
+    flat = " ".join(_text("docs/bifurcation/README.md").split())
+    cells = _json("docs/performance/float32_periodic_check.json")["cells"]
+
+    def span(run):
+        g = [c[run]["gap_at_float64_period"] for c in cells]
+        return f"{min(g):.1e}–{max(g):.1e}".replace("e-0", "e-")
+
+    assert all(c["float64_rtol1e-8"]["regime"] == c["float64_rtol1e-6"]["regime"] == "periodic" for c in cells)
+    assert all(c["float32_rtol1e-6"]["regime"] == "aperiodic" for c in cells)
+    for q in (f"{len(cells)} such cells", f"to {span('float64_rtol1e-8')} in float64 at rtol 1e-8",
+              f"to {span('float64_rtol1e-6')} at rtol 1e-6", f"only to {span('float32_rtol1e-6')} (aperiodic)"):
+        assert q in flat, q
