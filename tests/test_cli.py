@@ -53,6 +53,8 @@ BAD_INPUT = [
     (["bifurcation", "--host-devices", "0"], "--host-devices"),
     (["bifurcation", "--host-processes", "0"], "--host-processes"),
     (["map", "--host-processes", "two"], "--host-processes"),
+    (["bifurcation", "--engine", "gpu"], "--engine"),
+    (["map", "--engine", "kernel", "--host-processes", "2"], "--engine"),
     (["bifurcation", "--param", "nonsense", "--values", "1,2"], "--param"),
     (["bifurcation", "--param", "mu"], "--values"),
     (["bifurcation", "--param", "mu", "--values", "0.1,-0.2"], "'mu'"),
@@ -105,6 +107,13 @@ def test_bad_input_from_the_shell():
     r = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ, JAXCELT_CACHE_DIR="off"))
     assert r.returncode == 2
     assert r.stderr.splitlines() == ["jaxcelt bifurcation: error: parameter 'mu' must be >= 0, got -1.0"]
+
+
+def test_cli_engines_are_the_library_engines():
+    from jaxcelt.commands.bifurcation import ENGINES
+    from jaxcelt.ensemble import ENGINES as LIBRARY_ENGINES
+
+    assert ENGINES == LIBRARY_ENGINES
 
 
 def test_import_does_not_start_the_jax_backend():

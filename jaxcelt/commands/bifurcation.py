@@ -15,6 +15,8 @@ from pathlib import Path
 
 from .args import UsageError, floats, nonnegative_int, override, overrides, positive_float, positive_int, value_range
 
+ENGINES = ("auto", "pool", "kernel")
+"""`jaxcelt.ensemble.ENGINES`, written out: the CLI parses its arguments before it imports JAX"""
 SWEEP_SOLVERS = ("Tsit5", "Dopri5", "Dopri8")  # names in jaxcelt.benchmarking.SOLVERS
 
 
@@ -76,6 +78,7 @@ def register(sub) -> None:
         default=None,
         help="pool slots per device: lanes stepped side by side (vmap width; default jaxcelt.sweep.DEFAULT_WIDTH)",
     )
+    p.add_argument("--engine", default="auto", choices=ENGINES, help="how lanes are stepped: auto (the lane kernel on a GPU, the pool elsewhere), pool, or kernel (off a GPU it runs interpreted: for tests, slow)")
     p.add_argument(
         "--host-devices",
         default="auto",
@@ -230,6 +233,8 @@ def lane_devices(args):
         n = 0
     if n != "auto" and n < 1:
         raise UsageError(f"argument --host-processes: must be an integer >= 1 or 'auto', got {spec!r}")
+    if getattr(args, "engine", "auto") == "kernel":
+        raise UsageError("argument --engine: 'kernel' steps lanes on a GPU; --host-processes starts CPU workers")
     _set_host_devices("1")
     from jaxcelt.ensemble import HostProcesses
 
@@ -272,6 +277,7 @@ def run_settings(args, wall: float, devices=None) -> dict:
         "devices": [str(d) for d in jax.local_devices()] if devices is None else repr(devices),
         "chunk_size": args.chunk_size,
         "width_per_device": args.width or DEFAULT_WIDTH,
+        "engine": args.engine,
         "wall_seconds_including_compile": round(wall, 2),
     }
 
@@ -327,6 +333,7 @@ def run(args) -> int:
             max_steps=args.max_steps,
             chunk_size=args.chunk_size,
             width=args.width,
+            engine=args.engine,
             stop_on_invalid=args.stop_on_invalid,
             sort_by_cost=True,
             devices=devices,

@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 
 from .args import UsageError, floats, nonnegative_int, override, overrides, positive_float, positive_int, value_range
-from .bifurcation import SWEEP_SOLVERS, add_host_processes, lane_devices, run_settings
+from .bifurcation import ENGINES, SWEEP_SOLVERS, add_host_processes, lane_devices, run_settings
 
 
 def register(sub) -> None:
@@ -49,6 +49,7 @@ def register(sub) -> None:
     p.add_argument(
         "--width", type=positive_int, default=None, help="pool slots per device (default jaxcelt.sweep.DEFAULT_WIDTH)"
     )
+    p.add_argument("--engine", default="auto", choices=ENGINES, help="how lanes are stepped: auto (the lane kernel on a GPU, the pool elsewhere), pool, or kernel (off a GPU it runs interpreted: for tests, slow)")
     p.add_argument("--host-devices", default="auto",
                    help="CPU only: split the CPU into this many JAX devices ('auto' = cores, 1 = off)")  # fmt: skip
     add_host_processes(p)
@@ -128,7 +129,7 @@ def run(args) -> int:
         ds = jc.parameter_map(
             params, x=x, y=y, y0=y0, transient_periods=args.transient, sample_periods=args.sample,
             lyapunov_periods=args.lyapunov, solver=make_solver(args.solver), rtol=args.rtol, atol=args.atol,
-            max_steps=args.max_steps, chunk_size=args.chunk_size, width=args.width,
+            max_steps=args.max_steps, chunk_size=args.chunk_size, width=args.width, engine=args.engine,
             stop_on_invalid=args.stop_on_invalid, dtype=args.dtype, sort_by_cost=True, devices=devices,
             out=str(args.out), progress=True,
         )  # fmt: skip
@@ -142,6 +143,7 @@ def run(args) -> int:
         "set": args.set,
         **run_settings(args, wall, devices),
         "dtype": args.dtype,
+        "engine": args.engine,
         "load_average_at_start": None if load is None else [round(v, 2) for v in load],
         **summarize(ds),
     }

@@ -301,6 +301,8 @@ def run_lanes_with_stats(
         raise ValueError(f"engine='kernel' needs an explicit FSAL Runge-Kutta solver, got {type(cfg.solver).__name__}")
 
     if isinstance(devices, HostProcesses):
+        if engine == "kernel":
+            raise ValueError("engine='kernel' steps lanes on a GPU; HostProcesses are CPU worker processes (use the pool)")
         kw = dict(width=width, compile_only=compile_only, pilot_fraction=pilot_fraction)
         kw.update(drain_factor=drain_factor, min_drain_width=min_drain_width)
         return devices.run(pb, y0b, cfg, pad_to=pad_to, varying=tuple(varying), **kw)
