@@ -35,7 +35,7 @@ def main() -> int:
     from jaxcelt.plotting.map import PARAM_LABELS, map_categories
 
     cats = map_categories(np.zeros(0, int), np.zeros(0, int))[1]
-    runs = [r for r in json.loads(a.records.read_text())["session_2"] if "grid" in r]
+    runs = [r for r in json.loads(a.records.read_text())["machine_2"] if "grid" in r]
     t = {r["dtype"]: r for r in runs}
     cmap = ListedColormap([c for _, c in cats])
     norm = BoundaryNorm(np.arange(len(cats) + 1) - 0.5, len(cats))

@@ -590,11 +590,11 @@ def test_gpu_kernel_table_from_json():
     def sp(n):
         return f"{n:,}".replace(",", " ")
 
-    maps = [r for r in d["session_2"] if "grid" in r]
+    maps = [r for r in d["machine_2"] if "grid" in r]
     f64 = next(r for r in maps if r["dtype"] == "float64")
     f32 = next(r for r in maps if r["dtype"] == "float32")
-    earlier = next(r for r in d["session_1"] if "grid" in r and r["dtype"] == "float64")
-    final = {r["dtype"]: r for r in d["session_4"] if "grid" in r}
+    earlier = next(r for r in d["machine_1"] if "grid" in r and r["dtype"] == "float64")
+    final = {r["dtype"]: r for r in d["machine_4"] if "grid" in r}
     for r in (f64, f32, earlier, final["float64"], final["float32"]):
         st = r["status_counts"]
         row = (f"{r['compile_s']:.1f} s", f"{r['run_s']:.1f} s", sp(round(r["lanes_per_s"])),
@@ -606,9 +606,9 @@ def test_gpu_kernel_table_from_json():
         for q in row:
             assert q in line, (q, line)
     assert earlier["steps_total"] == f64["steps_total"] == final["float64"]["steps_total"]  # "the same number of lane-steps"
-    chk32 = next(r["check"] for r in d["session_4"] if "check" in r)["float32"]
-    comp = next(r["comparison"] for r in d["session_2"] if "comparison" in r)
-    chk = next(r["check"] for r in d["session_1"] if "check" in r)["float64"]
+    chk32 = next(r["check"] for r in d["machine_4"] if "check" in r)["float32"]
+    comp = next(r["comparison"] for r in d["machine_2"] if "comparison" in r)
+    chk = next(r["check"] for r in d["machine_1"] if "check" in r)["float64"]
     quotes = [
         f"**Target met: {f64['run_s']:.1f} s, {earlier['run_s']:.1f} s and {final['float64']['run_s']:.1f} s**",
         f"64 of 64 the same status, step counts within {chk32['max_step_difference']} of each other, samples within "
@@ -621,14 +621,14 @@ def test_gpu_kernel_table_from_json():
         f"{100 * comp['same_category_fraction']:.1f} %",
         f"{sp(f64['regime_counts']['period 3-16'])} cells in float64, {f32['regime_counts']['period 3-16']} in float32",
     ]
-    side = {r["engine"]: r for r in d["session_3"] if "grid" in r}  # equal work, one machine
+    side = {r["engine"]: r for r in d["machine_3"] if "grid" in r}  # equal work, one machine
     k, p = side["auto"], side["pool"]
     assert k["engine_used"] == "kernel" and p["engine_used"] == "pool" and k["periods"] == p["periods"]
     quotes += [
         f"the kernel {k['run_s']:.1f} s, the pool {p['run_s']:.1f} s (**{p['run_s'] / k['run_s']:.1f}×**)",
         f"({k['compile_s']:.1f} s and {p['compile_s']:.1f} s); {sp(k['steps_total'])} against {sp(p['steps_total'])} lane-steps",
     ]
-    broken = next(r for r in d["session_1"] if "grid" in r and r["dtype"] == "float32")  # times still float32
+    broken = next(r for r in d["machine_1"] if "grid" in r and r["dtype"] == "float32")  # times still float32
     quotes.append(f"collapsed the step of {sp(broken['status_counts']['3'])} of its {sp(broken['lanes'])} lanes")
     assert chk["same_steps"] == chk["same_status"] == 64
     for q in quotes:
