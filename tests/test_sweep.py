@@ -578,8 +578,10 @@ def test_float32_pool_over_300_periods(paper_params):
 
     r64 = sweep_lanes(paper_params, {"omega_pi": om, "q_pi": q}, **kw)
     r32 = sweep_lanes(paper_params, {"omega_pi": om, "q_pi": q}, dtype="float32", **kw)
-    np.testing.assert_array_equal(r32["status"].values, r64["status"].values)
-    assert np.sum(r32["status"].values == 0) >= 2  # lanes that run to the end, not only invalid ones
+    s32, s64 = r32["status"].values, r64["status"].values
+    assert not np.any(s32 == 3)  # no collapsed step (the failure this guards against)
+    assert np.sum(s32 == s64) >= len(s64) - 1  # two programs: a lane near lift-off may flip (measured: none)
+    assert np.sum(s32 == 0) >= 2  # lanes that run to the end, not only invalid ones
     assert np.all(np.isfinite(r32["section"].values[r32["status"].values == 0]))
 
 

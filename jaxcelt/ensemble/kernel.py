@@ -37,7 +37,6 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._diffrax_adapter import t1_clip_floor
 from .._types import Array
 from ..contact import get_contact_law
 from ..model import field_time, vector_field_and_normal
@@ -249,24 +248,22 @@ def run_kernel_lanes(
     ts_all: Array,
     interpret: bool,
 ) -> tuple[dict[str, Array], Array, Array]:
-    """Every lane from its start (`jaxcelt.ensemble.start_lanes`' lane states) to its last section
-    time: (outputs as `jaxcelt.ensemble.lane_outputs` gives them, the samples (L, S, 13), the
-    kernel's loop iterations per lane summed over the calls). ``ts_all``: (L, S) section times,
-    float64 whatever the state's dtype (the kernel's times are float64)."""
+    """Every lane from its start (`jaxcelt.ensemble.start_lanes`' lane states, their times made float64
+    by `jaxcelt.ensemble.float64_times`) to its last section time: (outputs as
+    `jaxcelt.ensemble.lane_outputs` gives them, the samples (L, S, 13), the kernel's loop iterations
+    per lane summed over the calls). ``ts_all``: (L, S) float64 section times."""
     dt_ = seg.dtype
-    f64 = jnp.float64
     L, S = ts_all.shape
-    ts_all = ts_all.astype(f64)
     st = lanes0.step_state
     code = jnp.where(lanes0.done & (st.first_invalid_kind > 0) & seg.stop_on_invalid, 2, 0).astype(jnp.int32)
     s = dict(
         y=[lanes0.y[:, m] for m in range(13)],
         f=[st.f[:, m] for m in range(13)],
-        tprev=lanes0.tprev.astype(f64),
-        tnext=lanes0.tnext.astype(f64),
+        tprev=lanes0.tprev,
+        tnext=lanes0.tnext,
         num_steps=lanes0.num_steps.astype(jnp.int32),
         code=code,
-        first_invalid_t=st.first_invalid_t.astype(f64),
+        first_invalid_t=st.first_invalid_t,
         first_invalid_kind=st.first_invalid_kind.astype(jnp.int32),
         min_N=st.min_N,
         min_n3=st.min_n3,
@@ -274,8 +271,7 @@ def run_kernel_lanes(
     # padding lanes (done at the start without a reason) are parked: a step budget of zero
     parked = lanes0.done & (code == 0)
     s["num_steps"] = jnp.where(parked, seg.max_steps, s["num_steps"])
-    t1 = ts_all[:, -1]
-    floor = jax.vmap(t1_clip_floor)(t1)
+    t1, floor = lanes0.t1, lanes0.floor
 
     def call(flat, target):
         return seg(flat, target, t1, floor, pv, interpret)

@@ -242,6 +242,7 @@ def _kernel_chunk(
         seg = make_segment(cfg, params_of, len(pv))
         # the kernel's times are float64 (`jaxcelt.ensemble.kernel`): section times from the lanes' omega_pi
         ts64 = _section_times(jax.tree_util.tree_map(lambda x: x.astype(jnp.float64), pb), transient, cfg)
+        lanes = float64_times(lanes, ts64[:, -1])
         out, samples, iters = run_kernel_lanes(seg, lanes, tuple(pv), ts64, interpret)
         ts_all = ts64
         out = dict(out, samples=samples, t_samples=ts_all)
@@ -264,6 +265,14 @@ _lyap_chunk = {
     platform: eqx.filter_jit(_lyap_chunk_impl, compiler_options=compiler_options(platform))
     for platform in ("cpu", "other")
 }
+
+
+def check_engine(engine: str, solver: Any) -> None:
+    """ValueError unless ``engine`` is one of `ENGINES` and can run ``solver``."""
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
+    if engine == "kernel" and not kernel_supported(solver):
+        raise ValueError(f"engine='kernel' needs an explicit FSAL Runge-Kutta solver, got {type(solver).__name__}")
 
 
 def varying_names(pb: CeltParams) -> set[str]:
@@ -295,10 +304,7 @@ def run_lanes_with_stats(
     iterations, one per step of its slowest lane, with ``width`` = `BLOCK`)."""
     from .processes import HostProcesses
 
-    if engine not in ENGINES:
-        raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
-    if engine == "kernel" and not kernel_supported(cfg.solver):
-        raise ValueError(f"engine='kernel' needs an explicit FSAL Runge-Kutta solver, got {type(cfg.solver).__name__}")
+    check_engine(engine, cfg.solver)
 
     if isinstance(devices, HostProcesses):
         if engine == "kernel":
