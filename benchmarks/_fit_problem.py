@@ -27,8 +27,8 @@ def release(p, tilt: float, spin: float, heading: float = 0.0):
 
 
 def records(noise: float = 0.0, kinds=("omega",)):
-    """The two records (`jaxcelt.data.MeasuredData`), noise as a fraction of each channel's RMS."""
-    from jaxcelt.data import generate_data
+    """The two records (`jaxcelt.identify.records.MeasuredData`), noise as a fraction of each channel's RMS."""
+    from jaxcelt.identify.records import generate_data
 
     _, true = paper_and_true()
     starts = [release(true, 10.0, 5.0), release(true, 6.0, -3.0)]

@@ -232,7 +232,7 @@ def _dopri_lane(y0, t0, ts, P, B, Bi, rtol, atol, max_steps, out_ys, C, A, B5, E
         fac = 10.0 if err == 0 else min(10.0, max(0.2, 0.9 * err ** (-1 / 5)))
         h = hh * fac
         if err > 1.0 and h < 10.0 * (np.nextafter(t, np.inf) - t):
-            return steps, evals, 3  # step size collapsed (scipy's rule, as jaxcelt.solve.MIN_STEP_ULPS)
+            return steps, evals, 3  # step size collapsed (scipy's rule, as jaxcelt.integrate.solve.MIN_STEP_ULPS)
     return steps, evals, 0
 
 

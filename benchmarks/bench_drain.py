@@ -35,7 +35,7 @@ def main():
     jax.config.update("jax_num_cpu_devices", os.cpu_count() or 1)
     import jaxcelt as jc
     from jaxcelt.ensemble import stroboscopic as sb
-    from jaxcelt.sweep import SweepConfig
+    from jaxcelt.sweeps.sweep import SweepConfig
     from jaxcelt.versions import versions
 
     V = versions()

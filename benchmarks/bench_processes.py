@@ -56,7 +56,7 @@ def main() -> None:
     import _numba_model as nm
 
     from jaxcelt.ensemble.stroboscopic import run_lanes_with_stats
-    from jaxcelt.sweep import SweepConfig, lanes_params
+    from jaxcelt.sweeps.sweep import SweepConfig, lanes_params
     from jaxcelt.versions import versions
 
     V = versions()

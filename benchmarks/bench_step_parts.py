@@ -26,11 +26,11 @@ import jax.numpy as jnp
 import numpy as np
 
 import jaxcelt as jc
-from jaxcelt.contact import get_contact_law
 from jaxcelt.ensemble import make_stepper
-from jaxcelt.model import vector_field
-from jaxcelt.solve import DEFAULT_SOLVER, _invalid_kind
-from jaxcelt.sweep import lanes_params
+from jaxcelt.integrate.solve import DEFAULT_SOLVER, _invalid_kind
+from jaxcelt.physics.contact.registry import get_contact_law
+from jaxcelt.physics.model import vector_field
+from jaxcelt.sweeps.sweep import lanes_params
 
 PARTS = (
     "rhs",

@@ -1,7 +1,7 @@
 """Where a fit's compilation goes (writes docs/fit/compile_parts.json).
 
 The problem of ``benchmarks/bench_fit.py`` (two 1 s gyro records, 4 parameters). For the evaluation
-program (`jaxcelt.fit._value_and_jacobian`: residuals and forward-mode Jacobian) it times tracing +
+program (`jaxcelt.identify.fit._value_and_jacobian`: residuals and forward-mode Jacobian) it times tracing +
 lowering and XLA compilation apart, counts the host callbacks in it, and -- in two fresh processes
 sharing an empty persistent compilation cache -- whether the second process loads it from the cache.
 Modes: ``raise``, equinox's runtime checks as host callbacks (equinox's default); ``nan``, traced

@@ -2,7 +2,7 @@
 (writes docs/fit/records_parallel.json).
 
 The problem of ``benchmarks/bench_fit.py`` (two 1 s gyro records, 4 parameters) at the paper's
-values: (r, J) by ``jaxcelt.fit._evaluate`` (on a multi-core CPU: each record by the one-record
+values: (r, J) by ``jaxcelt.identify.fit._evaluate`` (on a multi-core CPU: each record by the one-record
 program in its own thread), by the all-records program (`jax.lax.map` over the records,
 ``_evaluate_program``), and by the one-record program called for each record in turn. Compiled
 first; best of ``--reps`` warm calls each; the results of the modes are compared.

@@ -82,7 +82,7 @@ def main() -> int:
     import jaxcelt as jc
     from jaxcelt.ensemble import lanes_params, run_lanes
     from jaxcelt.plotting.map import map_categories
-    from jaxcelt.sweep import SweepConfig
+    from jaxcelt.sweeps.sweep import SweepConfig
     from jaxcelt.versions import versions
 
     ver = versions()
@@ -165,7 +165,7 @@ def check(a) -> dict:
 
     import jaxcelt as jc
     from jaxcelt.ensemble import run_lanes
-    from jaxcelt.sweep import SweepConfig
+    from jaxcelt.sweeps.sweep import SweepConfig
     from jaxcelt.versions import versions
 
     p = jc.CeltParams.paper()

@@ -37,8 +37,8 @@ PRE_IMPORTED = (
     "tqdm.auto",
     "PIL.Image",
     "jaxcelt.cli",
-    "jaxcelt.dataset",
-    "jaxcelt.sweep",
+    "jaxcelt.sweeps.dataset",
+    "jaxcelt.sweeps.sweep",
     "jaxcelt.plotting.bifurcation",
 )
 

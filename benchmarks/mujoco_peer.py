@@ -44,7 +44,7 @@ from mujoco import rollout
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import jaxcelt as jc  # noqa: E402
-from jaxcelt import benchmarking as bm  # noqa: E402
+from jaxcelt.studies import benchmarking as bm  # noqa: E402
 from jaxcelt.versions import versions  # noqa: E402
 
 jax.config.update("jax_enable_x64", True)

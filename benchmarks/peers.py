@@ -37,7 +37,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import _numba_model as nm  # noqa: E402
 
 import jaxcelt as jc  # noqa: E402
-from jaxcelt import benchmarking as bm  # noqa: E402
+from jaxcelt.studies import benchmarking as bm  # noqa: E402
 from jaxcelt.versions import versions  # noqa: E402
 
 

@@ -1,6 +1,6 @@
 """Reference-solution protocol: two different integrators at tolerance <= 1e-13 must agree.
 
-For each scene (`jaxcelt.benchmarking.make_scene`) and horizon:
+For each scene (`jaxcelt.studies.benchmarking.make_scene`) and horizon:
 
 * A: diffrax ``Dopri8`` (jaxcelt.simulate, rtol = atol = 1e-13, samples stepped onto exactly);
 * B: scipy ``solve_ivp(DOP853)`` (Hairer's code, a different implementation and step-size
@@ -30,7 +30,7 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import jaxcelt as jc  # noqa: E402
-from jaxcelt import benchmarking as bm  # noqa: E402
+from jaxcelt.studies import benchmarking as bm  # noqa: E402
 from jaxcelt.versions import versions  # noqa: E402
 
 TOL = 1e-13

@@ -71,8 +71,8 @@ def main():
 
     import jaxcelt as jc
     from jaxcelt._compile_options import pool_compiler_options
-    from jaxcelt.contact import get_contact_law
-    from jaxcelt.model import vector_field
+    from jaxcelt.physics.contact.registry import get_contact_law
+    from jaxcelt.physics.model import vector_field
     from jaxcelt.versions import versions
 
     p = jc.CeltParams.paper()

@@ -12,11 +12,11 @@
     2.785/rho (RK4) and 2/rho (Heun) from the spectral radius rho of the Jacobian along the
     reference.
 (c) float32 against float64 from rest at omega_pi = 14, 17, 19 over 50 periods: time at which the
-    trajectories separate by > 1e-2 and whether the regime label (`jaxcelt.regimes.classify`)
+    trajectories separate by > 1e-2 and whether the regime label (`jaxcelt.sweeps.regimes.classify`)
     changes; float64 at the float32 tolerance as control.
 (d) |d loss / d mu| against the horizon (1 ... 32 periods) at omega_pi = 17 and 19, loss = mean
     squared (v, omega) over the stroboscopic samples, next to the finite-time Lyapunov growth
-    from `jaxcelt.lyapunov.celt_lyapunov`; compiled memory of reverse mode
+    from `jaxcelt.integrate.lyapunov.celt_lyapunov`; compiled memory of reverse mode
     (RecursiveCheckpointAdjoint) against horizon and max_steps.
 (e) geometric singularities: n2 -> 1 (psi equation), contact near the tip of the long axis,
     lift-off (N -> 0).
@@ -44,9 +44,9 @@ import numpy as np
 import optimistix as optx
 
 import jaxcelt as jc
-from jaxcelt import benchmarking as bm
-from jaxcelt.lyapunov import celt_lyapunov
-from jaxcelt.regimes import classify, regime_names
+from jaxcelt.integrate.lyapunov import celt_lyapunov
+from jaxcelt.studies import benchmarking as bm
+from jaxcelt.sweeps.regimes import classify, regime_names
 from jaxcelt.versions import versions
 
 WRONG_TOL = 1e-2  # max |y - y_ref| over samples and components (SI) that counts as a wrong attractor
@@ -320,7 +320,7 @@ def part_c(part, args):
     periods = 10 if args.quick else args.c_periods
     part.set("setup", dict(periods=periods, solver="Tsit5", f32="rtol 1e-5 atol 1e-7", f64="rtol 1e-8 atol 1e-10",
                            control="float64 at rtol 1e-5 atol 1e-7", separation=WRONG_TOL,
-                           regime="jaxcelt.regimes.classify on the last half of the stroboscopic samples, tol 1e-3, no Lyapunov exponent"))  # fmt: skip
+                           regime="jaxcelt.sweeps.regimes.classify on the last half of the stroboscopic samples, tol 1e-3, no Lyapunov exponent"))  # fmt: skip
     for w in (14, 17, 19):
         sc = bm.make_scene(f"rest{w}", periods)
         runs = {}

@@ -46,7 +46,7 @@ def child(variant: str, mode: str, n_freq: int, periods: int, sample: int, runs:
     import jaxcelt as jc
     import jaxcelt._compile_options as co
     from jaxcelt.ensemble.stroboscopic import run_lanes_with_stats
-    from jaxcelt.sweep import SweepConfig, lanes_params
+    from jaxcelt.sweeps.sweep import SweepConfig, lanes_params
 
     if variant == "256":
         co.WIDE_VECTORS.clear()  # the pool compiled with XLA's defaults

@@ -32,7 +32,7 @@ import numpy as np
 import optimistix as optx
 
 import jaxcelt as jc
-from jaxcelt import benchmarking as bm
+from jaxcelt.studies import benchmarking as bm
 from jaxcelt.versions import versions
 
 EXPLICIT = ["Tsit5", "Dopri5", "Dopri8"]

@@ -5,26 +5,41 @@ of Awrejcewicz & Kudra (2014). See MODEL.md for the equations.
 Importing jaxcelt enables float64 in JAX (``jax_enable_x64``).
 """
 
-from . import _config  # noqa: F401  (float64 on)
-from .attractors import AttractorCensus, AttractorStarts, attractor_starts, attractors
-from .celt_orbit import CeltOrbit, continue_orbit, periodic_orbit
-from .contact import CONTACT_LAWS, AbstractContactLaw, Coulomb, CoulombSpin, GeneralisedPade, Pade, get_contact_law
-from .data import MeasuredData, Trajectory, generate_data, load_data, save_data
-from .diagnostics import Diagnostics, centre_position, diagnostics, energy, tilt
-from .elliptic import contact_integrals, ellipke
-from .ensemble import HostProcesses
-from .fit import FitResult, fit, project_state  # noqa: F811  (jaxcelt.fit is the function)
-from .integral_law import CustomProfile, HertzProfile, IntegralLaw, UniformProfile, patch_integrals, profile_moments
-from .ladder import Scene, hertz_params, run_ladder
-from .lyapunov import celt_lyapunov, largest_lyapunov
-from .model import STATE_NAMES, kinematics, normal_force, vector_field
-from .noslip import simulate_noslip
-from .params import PARAM_NAMES, CeltParams
-from .solve import INVALID_KINDS, STATUS, Solution, simulate
-from .state import check_state, constraint_residual, initial_state
-from .sweep import SweepResult, bifurcation, continuation, parameter_map, sweep_lanes
+import sys
+
+from jaxcelt import (
+    _config,  # noqa: F401  (float64 on)
+    _moved,
+)
+from jaxcelt.ensemble import HostProcesses
+from jaxcelt.identify.fit import FitResult, fit, project_state  # noqa: F811  (jaxcelt.fit is the function)
+from jaxcelt.identify.records import MeasuredData, Trajectory, generate_data, load_data, save_data
+from jaxcelt.integrate.lyapunov import celt_lyapunov, largest_lyapunov
+from jaxcelt.integrate.noslip import simulate_noslip
+from jaxcelt.integrate.solve import INVALID_KINDS, STATUS, Solution, simulate
+from jaxcelt.orbits.celt import CeltOrbit, continue_orbit, periodic_orbit
+from jaxcelt.physics.contact.elliptic import contact_integrals, ellipke
+from jaxcelt.physics.contact.integral import (
+    CustomProfile,
+    HertzProfile,
+    IntegralLaw,
+    UniformProfile,
+    patch_integrals,
+    profile_moments,
+)
+from jaxcelt.physics.contact.laws import AbstractContactLaw, Coulomb, CoulombSpin, GeneralisedPade, Pade
+from jaxcelt.physics.contact.registry import CONTACT_LAWS, get_contact_law
+from jaxcelt.physics.diagnostics import Diagnostics, centre_position, diagnostics, energy, tilt
+from jaxcelt.physics.model import STATE_NAMES, kinematics, normal_force, vector_field
+from jaxcelt.physics.params import PARAM_NAMES, CeltParams
+from jaxcelt.physics.state import check_state, constraint_residual, initial_state
+from jaxcelt.studies.ladder import Scene, hertz_params, run_ladder
+from jaxcelt.sweeps.census import AttractorCensus, AttractorStarts, attractor_starts, attractors
+from jaxcelt.sweeps.sweep import SweepResult, bifurcation, continuation, parameter_map, sweep_lanes
 
 __version__ = "0.1.0"
+
+_moved.install(sys.modules[__name__])
 
 __all__ = [
     "AttractorCensus",

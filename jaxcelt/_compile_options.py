@@ -10,7 +10,7 @@ AVX-512 the option changes nothing (LLVM caps the width at what the CPU has; che
 time, and a narrow pool gains nothing from them (the main job's pool of 30 slots per device ran
 no faster with them and compiled longer), so only pools of at least `WIDE_VECTORS_MIN_SLOTS`
 slots per device get them (the 400 x 300 sweep has 96), together with the contact law's
-``wide_batch`` form (`jaxcelt.contact.AbstractContactLaw.wide_batch`: the vectorised logarithm,
+``wide_batch`` form (`jaxcelt.physics.contact.laws.AbstractContactLaw.wide_batch`: the vectorised logarithm,
 which also costs compilation; `is_wide_pool`). The Lyapunov stage and the fit,
 compiled with the loop emitters below, do not gain from them and go without.
 

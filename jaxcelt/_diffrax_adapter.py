@@ -4,7 +4,7 @@ jaxcelt uses diffrax's public API everywhere except where it has to reproduce wh
 `diffrax.diffeqsolve` does inside its loop: the lane pool (`jaxcelt.ensemble`) steps many
 solves side by side in its own while loop and must take the same steps as `diffeqsolve`, the
 Lyapunov exponent's per-period solves take them in a smaller program (`solve_to`), and
-`jaxcelt.solve` passes diffrax's "use the step-size tolerances" marker to an implicit solver's
+`jaxcelt.integrate.solve` passes diffrax's "use the step-size tolerances" marker to an implicit solver's
 root finder. The names below are not re-exported by diffrax or equinox, or mirror the body of
 diffrax's integration loop (``diffrax/_integrate.py``: ``loop``, ``body_fun_aux``,
 ``_clip_to_end``), so they can change in any release. The versions they were written against
@@ -25,7 +25,7 @@ import jax.numpy as jnp
 from diffrax._root_finder import use_stepsize_tol  # not re-exported at top level
 from diffrax._term import WrapTerm  # what diffeqsolve wraps terms in (not re-exported)
 
-from ._types import Array
+from jaxcelt._types import Array
 
 __all__ = [
     "use_stepsize_tol",

@@ -39,7 +39,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._types import Array, ArrayLike
+from jaxcelt._types import Array, ArrayLike
 
 __all__ = ["cross3", "log", "matvec3", "sincos"]
 

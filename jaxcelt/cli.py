@@ -60,7 +60,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     _enable_compile_cache()
     if args.version:
-        from .versions import versions_string
+        from jaxcelt.versions import versions_string
 
         print(versions_string())
         return 0

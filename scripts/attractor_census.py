@@ -1,7 +1,7 @@
 """Attractor census of the wobblestone at omega_pi = 14, 15.6, 17, 19 rad/s (paper parameters).
 
 Every frequency: a psi0 x tilt grid of starts at rest (`jaxcelt.attractor_starts`), each run as
-one lane of `jaxcelt.sweep` (`jaxcelt.attractors`): transient, then stroboscopic samples,
+one lane of `jaxcelt.sweeps.sweep` (`jaxcelt.attractors`): transient, then stroboscopic samples,
 labelled periodic-k / quasi-periodic / chaotic / aperiodic / invalid / failed; periodic lanes
 grouped into distinct attractors. Resumable per frequency: a frequency whose result (with the same grid, tilt and
 periods) is in ``<out>/census/omega_<w>.json`` is skipped. Writes ``<out>/census.json`` (all frequencies:
@@ -73,7 +73,7 @@ def run_one(w: float, args) -> dict:
 
 def refine_stored(w: float, d: dict) -> None:
     """Refine the stored periodic rows with `jaxcelt.periodic_orbit` (in place; timed)."""
-    from jaxcelt.attractors import Attractor, refine_attractor
+    from jaxcelt.sweeps.census import Attractor, refine_attractor
 
     p = jc.CeltParams.paper(omega_pi=w)
     for row in d["attractors"]:

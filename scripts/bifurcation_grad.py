@@ -10,8 +10,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxcelt.bifurcation_point import locate_period_doubling
-from jaxcelt.periodic import stroboscopic_map
+from jaxcelt.orbits.points import locate_period_doubling
+from jaxcelt.orbits.shooting import stroboscopic_map
 from jaxcelt.versions import versions
 
 OMEGA, DELTA, H = 1.2, 0.3, 1e-4

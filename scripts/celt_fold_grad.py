@@ -2,7 +2,7 @@
 central finite differences of the located point -> docs/orbits/celt_fold_grad.json.
 
 Starts from the fold that `scripts/orbit_branches.py` found by continuation (docs/orbits/branches.json),
-refines it with `jaxcelt.celt_orbit.locate_orbit_bifurcation` (Newton on periodicity + bordered
+refines it with `jaxcelt.orbits.celt.locate_orbit_bifurcation` (Newton on periodicity + bordered
 det(M - I) in the chart of the contact manifold) and differentiates the located omega_pi in the
 friction coefficient mu. Timings are indicative (load average recorded; each call compiles).
 
@@ -23,8 +23,8 @@ import jax.numpy as jnp
 import numpy as np
 
 import jaxcelt as jc
-from jaxcelt.celt_orbit import locate_orbit_bifurcation
-from jaxcelt.model import STATE_NAMES
+from jaxcelt.orbits.celt import locate_orbit_bifurcation
+from jaxcelt.physics.model import STATE_NAMES
 from jaxcelt.versions import versions
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]

@@ -25,11 +25,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import jaxcelt as jc  # noqa: E402
-from jaxcelt.calibrate import _with, calibrate, error_map, integral_reference, slip_samples  # noqa: E402
-from jaxcelt.integral_law import HERTZ_S, patch_integrals  # noqa: E402
-from jaxcelt.ladder import HERTZ_CALIBRATED, builtin_scenes, needed_state, recommend, results_table, run_ladder  # noqa: E402
-from jaxcelt.noslip import simulate_noslip  # noqa: E402
+from jaxcelt.integrate.noslip import simulate_noslip  # noqa: E402
+from jaxcelt.physics.contact.calibrate import _with, calibrate, error_map, integral_reference, slip_samples  # noqa: E402
+from jaxcelt.physics.contact.integral import HERTZ_S, patch_integrals  # noqa: E402
 from jaxcelt.plotting.contact import plot_convergence, plot_cost_vs_error, plot_error_maps  # noqa: E402
+from jaxcelt.studies.ladder import HERTZ_CALIBRATED, builtin_scenes, needed_state, recommend, results_table, run_ladder  # noqa: E402
 
 OUT = pathlib.Path(__file__).resolve().parents[1] / "docs" / "contact"
 B = 0.1813

@@ -25,7 +25,7 @@ import jax.numpy as jnp
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from jaxcelt.orbit_continuation import continue_pseudo_arclength, switch_at_period_doubling
+from jaxcelt.orbits.branch import continue_pseudo_arclength, switch_at_period_doubling
 from jaxcelt.versions import versions
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]

@@ -21,8 +21,8 @@ from pathlib import Path
 import numpy as np
 
 import jaxcelt as jc
-import jaxcelt.data as D
-import jaxcelt.fit  # noqa: F401  (module, for the helpers below)
+import jaxcelt.identify.fit  # noqa: F401  (module, for the helpers below)
+import jaxcelt.identify.records as D
 from jaxcelt.plotting import fit as FP
 
 F = sys.modules["jaxcelt.fit"]  # `jaxcelt.fit` the attribute is the function
@@ -164,7 +164,7 @@ def coverage(out, seeds):
 # 40 forcing periods (13.2 s), full state at 20 samples per period (60.5 Hz), noise-free. At
 # omega_pi = 19 every release tried tips past 90 deg eventually (n3 < 0, outside the model; from
 # rest after 48.7 periods); the record ends before that and stays valid (max tilt 47 deg), and
-# along it the largest Lyapunov exponent (jaxcelt.lyapunov, Benettin) is positive. Roles: the data
+# along it the largest Lyapunov exponent (jaxcelt.integrate.lyapunov, Benettin) is positive. Roles: the data
 # come from the paper's values, every fit starts from the study's TRUE values (mu +40%,
 # k_r -40%, b_Ts +50%, m_Ts +35% off the truth).
 CHAOS_OMEGA = 19.0
@@ -189,7 +189,7 @@ def chaos_data():
 
 
 def _lyap(p, y0, periods, rtol=1e-9):
-    from jaxcelt.lyapunov import celt_lyapunov
+    from jaxcelt.integrate.lyapunov import celt_lyapunov
 
     r = celt_lyapunov(p, y0, periods=periods, rtol=rtol, atol=rtol * 1e-2)
     return np.asarray(r.log_growth), bool(r.success)

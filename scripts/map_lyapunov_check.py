@@ -12,7 +12,7 @@ docs/map/lyapunov_window_check.json:
 * ``long_transient``: 300 transient periods before the 20 samples, lambda_1 over 10.
 
 Each run's labels are recorded twice: ``label`` by the sweep's rule (the exponent's interval of
-+-2 batch-means standard errors, `jaxcelt.regimes.classify`) and ``label_point_estimate`` from the
++-2 batch-means standard errors, `jaxcelt.sweeps.regimes.classify`) and ``label_point_estimate`` from the
 exponent alone (no standard error), so the two rules can be compared on lanes whose long-window
 answer is known.
 
@@ -50,7 +50,7 @@ def main() -> int:
     a = ap.parse_args()
 
     import jaxcelt as jc
-    from jaxcelt.regimes import classify, regime_names
+    from jaxcelt.sweeps.regimes import classify, regime_names
     from jaxcelt.versions import versions
 
     p = jc.CeltParams.paper()

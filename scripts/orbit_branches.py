@@ -27,8 +27,8 @@ import jax
 import numpy as np
 
 import jaxcelt as jc
-from jaxcelt.model import STATE_NAMES
-from jaxcelt.orbit_continuation import ArclengthBranch, Bifurcation, branch_to_dict
+from jaxcelt.orbits.branch import ArclengthBranch, Bifurcation, branch_to_dict
+from jaxcelt.physics.model import STATE_NAMES
 from jaxcelt.versions import versions
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -5,7 +5,7 @@
 Writes ``fig3_<tag>.png`` (omega_2 at the section against omega_pi, coloured by regime) and
 ``fig4-7_<tag>_w<omega>.png`` (local phase plot omega_1-omega_3, global path of O, section) for
 omega_pi = 14, 15.6, 17, 19, plus ``figures_<tag>.json`` with the labels shown. Uses only the
-library (`jaxcelt.bifurcation`, `jaxcelt.sweep.orbit`, `jaxcelt.plotting.bifurcation`).
+library (`jaxcelt.bifurcation`, `jaxcelt.sweeps.sweep.orbit`, `jaxcelt.plotting.bifurcation`).
 """
 
 from __future__ import annotations
@@ -21,10 +21,10 @@ matplotlib.use("Agg")
 import numpy as np  # noqa: E402
 
 import jaxcelt as jc  # noqa: E402
-from jaxcelt.dataset import to_dataset  # noqa: E402
 from jaxcelt.plotting.bifurcation import bifurcation_figure, orbit_figure  # noqa: E402
-from jaxcelt.regimes import GLOBAL_MOTION, classify, regime_names  # noqa: E402
-from jaxcelt.sweep import SweepConfig, orbit  # noqa: E402
+from jaxcelt.sweeps.dataset import to_dataset  # noqa: E402
+from jaxcelt.sweeps.regimes import GLOBAL_MOTION, classify, regime_names  # noqa: E402
+from jaxcelt.sweeps.sweep import SweepConfig, orbit  # noqa: E402
 from jaxcelt.versions import versions  # noqa: E402
 
 PAPER = {

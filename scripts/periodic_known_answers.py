@@ -1,4 +1,4 @@
-"""Known-answer numbers of `jaxcelt.periodic` (the cases of tests/test_periodic.py) as JSON.
+"""Known-answer numbers of `jaxcelt.orbits.shooting` (the cases of tests/test_periodic.py) as JSON.
 
 Linear damped forced oscillator (analytic steady state and multipliers), Mathieu first
 instability tongue against the Ince-Strutt series (truncated after q^5), forced Duffing against

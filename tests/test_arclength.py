@@ -1,4 +1,4 @@
-"""Pseudo-arclength continuation passes folds (`jaxcelt.orbit_continuation.continue_pseudo_arclength`).
+"""Pseudo-arclength continuation passes folds (`jaxcelt.orbits.branch.continue_pseudo_arclength`).
 
 Hardening Duffing x'' + 0.2 x' + x + x^3 = 0.3 cos(w t), period-1 frequency response continued
 in w from 0.8 to 2.5: the resonance curve bends right, so the branch turns back once (upper
@@ -18,7 +18,7 @@ import jax.numpy as jnp
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from jaxcelt.orbit_continuation import continue_pseudo_arclength
+from jaxcelt.orbits.branch import continue_pseudo_arclength
 
 C, F = 0.2, 0.3
 

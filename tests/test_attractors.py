@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import jaxcelt as jc
-from jaxcelt.attractors import group, same_cycle
+from jaxcelt.sweeps.census import group, same_cycle
 
 
 def _cycle(k: int, seed: int) -> np.ndarray:
@@ -153,7 +153,7 @@ def test_plot_basins_grid():
 
 
 def test_refine_failure_is_reported_not_raised():
-    from jaxcelt.attractors import Attractor, refine_attractor
+    from jaxcelt.sweeps.census import Attractor, refine_attractor
 
     p = jc.CeltParams.paper(omega_pi=15.6)
     row = Attractor(kind="periodic", k=1, state=np.zeros(13), t_section=0.0, lane=0, count=1, fraction=1.0)

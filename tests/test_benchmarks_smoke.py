@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from jaxcelt import benchmarking as bm
+from jaxcelt.studies import benchmarking as bm
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "benchmarks"))
 

@@ -5,8 +5,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxcelt.bifurcation_point import locate_period_doubling
-from jaxcelt.periodic import stroboscopic_map
+from jaxcelt.orbits.points import locate_period_doubling
+from jaxcelt.orbits.shooting import stroboscopic_map
 
 OMEGA = 1.2
 T = 2 * np.pi / OMEGA

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from jaxcelt.calibrate import calibrate, integral_reference, slip_samples
-from jaxcelt.integral_law import patch_integrals
-from jaxcelt.ladder import HERTZ_CALIBRATED
+from jaxcelt.physics.contact.calibrate import calibrate, integral_reference, slip_samples
+from jaxcelt.physics.contact.integral import patch_integrals
+from jaxcelt.studies.ladder import HERTZ_CALIBRATED
 
 
 def test_reference_uses_linearity_in_d():

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 import jaxcelt as jc
-from jaxcelt.celt_orbit import celt_chart, celt_embed
+from jaxcelt.orbits.celt import celt_chart, celt_embed
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from jaxcelt.cli import main
-from jaxcelt.io import load_trajectory
+from jaxcelt.integrate.io import load_trajectory
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -143,7 +143,7 @@ def test_bifurcation_solver_option(tmp_path):
     # --solver reaches the sweep: the dataset records it, and the lanes equal a Python-API sweep
     # with that solver (1e-10: the pool-vs-simulate agreement; the device count may differ, which
     # changes the compiled program and so the rounding, ~1e-11 over a few periods).
-    from jaxcelt.dataset import open_sweep
+    from jaxcelt.sweeps.dataset import open_sweep
 
     out = tmp_path / "run"
     cmd = [sys.executable, "-m", "jaxcelt", "bifurcation", "--omega", "14,17", "--transient", "1", "--sample", "2",
@@ -179,7 +179,7 @@ def test_bifurcation_rejects_unknown_solver(capsys):
 
 
 def _labels(ds):
-    from jaxcelt.regimes import regime_names
+    from jaxcelt.sweeps.regimes import regime_names
 
     return regime_names(ds["regime"].values, ds["period"].values)
 

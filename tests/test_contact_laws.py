@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 import jaxcelt as jc
-from jaxcelt.contact import CONTACT_LAWS, ContactKinematics, law_name, pade_friction
-from jaxcelt.integral_law import HERTZ_S, patch_integrals
+from jaxcelt.physics.contact.integral import HERTZ_S, patch_integrals
+from jaxcelt.physics.contact.laws import ContactKinematics, pade_friction
+from jaxcelt.physics.contact.registry import CONTACT_LAWS, law_name
 
 B = 0.1813
 APPROX = ["generalised_pade", "pade", "coulomb_spin", "coulomb"]

@@ -1,4 +1,4 @@
-"""Synthetic measured data and the data file format (jaxcelt.data)."""
+"""Synthetic measured data and the data file format (jaxcelt.identify.records)."""
 
 import dataclasses
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import jaxcelt as jc
-from jaxcelt.data import OBSERVABLES, MeasuredData, generate_data, load_data, observe, save_data
+from jaxcelt.identify.records import OBSERVABLES, MeasuredData, generate_data, load_data, observe, save_data
 
 
 @pytest.fixture(scope="module")
@@ -112,7 +112,7 @@ def test_trajectory_validation(clean):
 
 
 def test_from_arrays_and_csv_errors(tmp_path):
-    from jaxcelt.data import from_arrays, load_csv
+    from jaxcelt.identify.records import from_arrays, load_csv
 
     t = np.linspace(0.0, 1.0, 11)
     w = np.column_stack([np.sin(t), np.cos(t), 0.1 + t])
@@ -141,7 +141,7 @@ def test_accelerometer_is_the_specific_force_of_the_trajectory():
     # (R rows E1, E2, n; MODEL.md section 4). The smoothed friction (eps = 1e-4 m/s) changes on
     # ~1e-4 s, so the jerk reaches ~1e4 m/s^3 (h = 1e-4 s gave 1e-4 errors): truncation
     # h^2 |v'''| / 6 ~ 2e-9, integration noise ~1e-13 / h ~ 1e-7: 1e-5 m/s^2 (1e-6 of g).
-    from jaxcelt.model import horizontal_frame
+    from jaxcelt.physics.model import horizontal_frame
 
     p = jc.CeltParams.paper(omega_pi=15.6)
     y0 = jc.initial_state(p, psi=np.radians(157.5))

@@ -13,8 +13,8 @@ import pytest
 import xarray as xr
 from _sweep_common import KW, VALUES
 
-from jaxcelt.dataset import DamagedChunkWarning, open_sweep
-from jaxcelt.sweep import bifurcation
+from jaxcelt.sweeps.dataset import DamagedChunkWarning, open_sweep
+from jaxcelt.sweeps.sweep import bifurcation
 
 VALUES8 = np.concatenate([VALUES, VALUES + 0.5])  # 2 chunks of the shared chunk shape (4 lanes)
 
@@ -156,7 +156,7 @@ def test_lane_fields_match_sweep_result():
     # must be SweepResult's fields, in order
     import dataclasses
 
-    from jaxcelt.dataset import LANE_FIELDS
-    from jaxcelt.sweep import SweepResult
+    from jaxcelt.sweeps.dataset import LANE_FIELDS
+    from jaxcelt.sweeps.sweep import SweepResult
 
     assert LANE_FIELDS == tuple(f.name for f in dataclasses.fields(SweepResult) if f.name not in ("name", "values"))

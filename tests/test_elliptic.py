@@ -1,4 +1,4 @@
-"""Complete elliptic integrals (jaxcelt.elliptic) against scipy.special: values and b-derivatives."""
+"""Complete elliptic integrals (jaxcelt.physics.contact.elliptic) against scipy.special: values and b-derivatives."""
 
 import jax
 import jax.numpy as jnp

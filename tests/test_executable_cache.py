@@ -112,7 +112,7 @@ def test_second_process_loads_the_fit_program(tmp_path):
         import numpy as np
         import jaxcelt as jc
         from jaxcelt import _executable_cache as ec
-        from jaxcelt.data import generate_data
+        from jaxcelt.identify.records import generate_data
         F = sys.modules["jaxcelt.fit"]
         p = jc.CeltParams.paper()
         y0 = jc.initial_state(p, omega=(0.0, 0.0, 5.0), n=(0.17, 0.0, 0.985), normalize=True)

@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 import jaxcelt as jc
-from jaxcelt.data import generate_data, save_data
-from jaxcelt.fit import Affine, Bounded, Positive, project_state
+from jaxcelt.identify.fit import Affine, Bounded, Positive, project_state
+from jaxcelt.identify.records import generate_data, save_data
 
 F = sys.modules["jaxcelt.fit"]
 FREE = ("mu", "k_r", "b_Ts", "m_Ts")
@@ -262,7 +262,7 @@ def test_must_show_3_chaotic_record_multiple_vs_single_shooting():
     period, states from the data, damped GN) recovers the parameters; single shooting from the
     same start does not (docs/identification.md, section 3: there it stalls after 1-3 accepted
     steps in 600 s; here 6 iterations keep the test to minutes)."""
-    from jaxcelt.lyapunov import celt_lyapunov
+    from jaxcelt.integrate.lyapunov import celt_lyapunov
 
     p = PAPER.replace(omega_pi=19.0)
     tp = 2 * np.pi / 19.0
@@ -283,12 +283,12 @@ def test_must_show_3_chaotic_record_multiple_vs_single_shooting():
 
 
 def test_cli_fit_csv_round_trip(tmp_path, short_imu, capsys):
-    """A record written as CSV (jaxcelt.data.save_csv) and fitted from the command line with an
+    """A record written as CSV (jaxcelt.identify.records.save_csv) and fitted from the command line with an
     initial guess gives the same data and a fit that moves from the guess toward the truth."""
     import json
 
     from jaxcelt.cli import main
-    from jaxcelt.data import load_csv, save_csv
+    from jaxcelt.identify.records import load_csv, save_csv
 
     tr = short_imu.subset(["omega"]).trajectories[0]
     path = save_csv(tr, tmp_path / "rec.csv")
@@ -338,7 +338,7 @@ def test_multistart_and_profile_likelihood():
 def test_fit_from_gyro_and_accelerometer_recovers_parameters():
     # two 1-s records of (omega, accel) at 100 Hz from known parameters (34-50 % off the start),
     # noise-free: LM recovers the four contact parameters to 1e-4 (converges to ~1e-7)
-    from jaxcelt.data import generate_data
+    from jaxcelt.identify.records import generate_data
 
     paper = jc.CeltParams.paper()
     true = paper.replace(mu=0.2241 * 1.4, k_r=0.4345 * 0.6, b_Ts=0.5305 * 1.5, m_Ts=0.8161 * 1.35)
@@ -357,7 +357,7 @@ def test_rotation_matrix_against_scipy():
     1e-14 (a few ulp of O(1) entries); the series branch below |r| = 1e-6 is exact to O(|r|^4)."""
     from scipy.spatial.transform import Rotation
 
-    from jaxcelt.data import rotation_matrix
+    from jaxcelt.identify.records import rotation_matrix
 
     for r in ([0.05, -0.03, 0.08], [1.0, 2.0, -0.5], [1e-8, 0.0, 3e-8], [0.0, 0.0, 0.0]):
         np.testing.assert_allclose(np.asarray(rotation_matrix(r)), Rotation.from_rotvec(r).as_matrix(), atol=1e-14)
@@ -367,7 +367,7 @@ def test_generate_data_sensor_axes_and_time_offset():
     """Sensor-axes gyro = R times the body-axes gyro of the same record; a time offset tau starts the
     record at model time tau: equal to `simulate` from y0 at t0 = tau (noise-free, both at the
     generator's tolerances; 1e-9 rad/s covers two solves of the same problem at rtol 1e-10)."""
-    from jaxcelt.data import rotation_matrix
+    from jaxcelt.identify.records import rotation_matrix
 
     rv, tau = np.array([0.05, -0.03, 0.08]), 0.013
     y0 = _start(TRUE)
@@ -418,7 +418,7 @@ def test_cli_fit_sensor_axes_csv(tmp_path, capsys):
     import json
 
     from jaxcelt.cli import main
-    from jaxcelt.data import save_csv
+    from jaxcelt.identify.records import save_csv
 
     rv, tau = [0.05, -0.03, 0.08], 0.013
     data = generate_data(TRUE, _start(TRUE), 0.3, rate=100, kinds=("omega", "accel"), sensor_rotation=rv, time_offset=tau)

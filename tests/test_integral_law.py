@@ -7,7 +7,14 @@ import pytest
 from scipy.integrate import dblquad
 
 import jaxcelt as jc
-from jaxcelt.integral_law import HERTZ_S, CustomProfile, HertzProfile, UniformProfile, patch_integrals, profile_moments
+from jaxcelt.physics.contact.integral import (
+    HERTZ_S,
+    CustomProfile,
+    HertzProfile,
+    UniformProfile,
+    patch_integrals,
+    profile_moments,
+)
 
 B = 0.1813
 _pi = jax.jit(patch_integrals, static_argnames=("profile", "n_angle", "n_radial"))

@@ -15,11 +15,11 @@ import numpy as np
 import pytest
 
 import jaxcelt as jc
-from jaxcelt.contact import get_contact_law
 from jaxcelt.ensemble import BLOCK, SweepConfig, blockwise, lanes_params, run_lanes
 from jaxcelt.ensemble.kernel import make_segment
 from jaxcelt.ensemble.soa import as_blocks, from_blocks
-from jaxcelt.model import vector_field_and_normal
+from jaxcelt.physics.contact.registry import get_contact_law
+from jaxcelt.physics.model import vector_field_and_normal
 
 P = jc.CeltParams.paper()
 LAW = get_contact_law(None)

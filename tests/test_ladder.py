@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import jaxcelt as jc
-from jaxcelt.ladder import Rung, RungResult, Scene, builtin_scenes, needed_state, recommend, run_ladder
+from jaxcelt.studies.ladder import Rung, RungResult, Scene, builtin_scenes, needed_state, recommend, run_ladder
 
 
 def _r(name, err, t, status=0, valid=True):

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import jaxcelt as jc
-from jaxcelt.lyapunov import celt_lyapunov, celt_tangent_projection, largest_lyapunov
+from jaxcelt.integrate.lyapunov import celt_lyapunov, celt_tangent_projection, largest_lyapunov
 
 
 def lorenz(t, y, args):
@@ -66,7 +66,7 @@ def test_celt_projection_keeps_manifold(paper_params):
 @pytest.mark.slow
 def test_celt_vmapped_matches_single(paper_params):
     y0 = jc.initial_state(paper_params)
-    from jaxcelt.sweep import lanes_params
+    from jaxcelt.sweeps.sweep import lanes_params
 
     pb = lanes_params(paper_params, "omega_pi", jnp.array([14.0, 17.0]))
     f = jax.jit(jax.vmap(lambda p, y: celt_lyapunov(p, y, periods=3)))

@@ -1,4 +1,4 @@
-"""A collapsing step size ends a solve (`jaxcelt.solve.MinStepController`, status 3) instead of
+"""A collapsing step size ends a solve (`jaxcelt.integrate.solve.MinStepController`, status 3) instead of
 spending the whole step budget, as scipy's `solve_ivp` does ("required step size is less than
 spacing between numbers")."""
 
@@ -19,7 +19,7 @@ from jaxcelt.ensemble import (
     split_lane_args,
     start_lanes,
 )
-from jaxcelt.solve import MinStepController
+from jaxcelt.integrate.solve import MinStepController
 
 RTOL, ATOL = 1e-8, 1e-10
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import jaxcelt as jc
-from jaxcelt.model import contact_geometry
-from jaxcelt.noslip import noslip_contact_force, noslip_vector_field, simulate_noslip
+from jaxcelt.integrate.noslip import noslip_contact_force, noslip_vector_field, simulate_noslip
+from jaxcelt.physics.model import contact_geometry
 
 
 def kl_params(**kw):

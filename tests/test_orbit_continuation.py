@@ -1,4 +1,4 @@
-"""Natural continuation of forced-ODE orbits with bifurcation detection (`jaxcelt.orbit_continuation`).
+"""Natural continuation of forced-ODE orbits with bifurcation detection (`jaxcelt.orbits.branch`).
 
 Double-well Duffing x'' + 0.3 x' - x + x^3 = F cos(1.2 t), right-well period-1 orbit continued in
 F: its multiplier passes -1 (period doubling). Checked by brute force with scipy DOP853 (an
@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from jaxcelt.orbit_continuation import continue_periodic_orbit
+from jaxcelt.orbits.branch import continue_periodic_orbit
 
 W = 1.2
 T = 2 * np.pi / W

@@ -13,8 +13,8 @@ matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
 
-from jaxcelt.model import STATE_NAMES  # noqa: E402
-from jaxcelt.orbit_continuation import ArclengthBranch, Bifurcation, branch_to_dict  # noqa: E402
+from jaxcelt.orbits.branch import ArclengthBranch, Bifurcation, branch_to_dict  # noqa: E402
+from jaxcelt.physics.model import STATE_NAMES  # noqa: E402
 from jaxcelt.plotting.orbits import branch_figure, multipliers_figure  # noqa: E402
 
 

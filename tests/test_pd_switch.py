@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from jaxcelt.orbit_continuation import continue_pseudo_arclength, switch_at_period_doubling
+from jaxcelt.orbits.branch import continue_pseudo_arclength, switch_at_period_doubling
 
 W, D = 1.2, 0.3
 T = 2 * np.pi / W

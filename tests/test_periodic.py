@@ -1,4 +1,4 @@
-"""Periodic orbits and Floquet multipliers of forced ODEs (`jaxcelt.periodic`), on known answers.
+"""Periodic orbits and Floquet multipliers of forced ODEs (`jaxcelt.orbits.shooting`), on known answers.
 
 * Linear damped forced oscillator x'' + d x' + w0^2 x = F cos(w t): the periodic orbit is the
   analytic steady state and the multipliers are exp((-d/2 +- i w_d) T), w_d = sqrt(w0^2 - d^2/4)
@@ -18,7 +18,7 @@ import jax.numpy as jnp
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from jaxcelt.periodic import find_periodic_orbit
+from jaxcelt.orbits.shooting import find_periodic_orbit
 
 TIGHT = dict(rtol=1e-12, atol=1e-13)
 LANES = 6  # every test runs the same compiled program: a batch of 6 lanes

@@ -7,7 +7,7 @@ import pytest
 
 import jaxcelt as jc
 from jaxcelt.ensemble.stroboscopic import run_lanes_with_stats
-from jaxcelt.sweep import SweepConfig, lanes_params
+from jaxcelt.sweeps.sweep import SweepConfig, lanes_params
 
 
 @pytest.fixture(scope="module")

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from jaxcelt.regimes import classify, detect_period, regime_names
+from jaxcelt.sweeps.regimes import classify, detect_period, regime_names
 
 
 def _samples(x):
@@ -70,7 +70,7 @@ def test_classify_exponent_interval():
 
 
 def test_exponent_stderr_batch_means():
-    from jaxcelt.lyapunov import exponent_stderr
+    from jaxcelt.integrate.lyapunov import exponent_stderr
 
     # 8 segments of length 0.5 in 4 blocks of 2: block exponents 1, 2, 3, 4 (sum of logs / 1.0 s);
     # std(ddof=1) of (1, 2, 3, 4) = sqrt(5/3), over sqrt(4): by hand, not by the code under test

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import jaxcelt as jc
-from jaxcelt.model import contact_loads
+from jaxcelt.physics.model import contact_loads
 
 T_REG = 0.1
 Y_REG = np.array(

@@ -15,7 +15,7 @@ import pytest
 from _sweep_common import KW, SAMPLE_ATOL, VALUES, assert_same_lanes
 
 import jaxcelt as jc
-from jaxcelt.sweep import bifurcation, continuation, lanes_params, parse_range
+from jaxcelt.sweeps.sweep import bifurcation, continuation, lanes_params, parse_range
 
 
 @pytest.fixture(scope="module")
@@ -64,7 +64,7 @@ def test_lyapunov_stage_equals_celt_lyapunov_and_starts_deferred_work(paper_para
     # period count changes lambda by ~0.1 1/s. The stage also starts programs deferred for later
     # (`prepare_orbit(defer=True)`): queued before the sweep, started by it, then used by `orbit`.
     from jaxcelt import _executable_cache as ec
-    from jaxcelt.sweep import orbit, prepare_orbit
+    from jaxcelt.sweeps.sweep import orbit, prepare_orbit
 
     okw = dict(transient_periods=1, periods=1, points_per_period=3)
     prepare_orbit(paper_params.replace(omega_pi=14.0), defer=True, **okw)
@@ -89,7 +89,7 @@ def test_failing_lane_is_isolated(base, paper_params):
     # another program than the base sweep, so rounding may differ; see _sweep_common).
     y0 = np.asarray(jc.initial_state(paper_params))
     params = paper_params
-    from jaxcelt.sweep import SweepConfig, run_lanes
+    from jaxcelt.sweeps.sweep import SweepConfig, run_lanes
 
     cfg = SweepConfig(transient_periods=3, sample_periods=4, max_steps=4000)
     pb = lanes_params(params, "omega_pi", VALUES)
@@ -140,7 +140,7 @@ def test_two_host_devices_equal_one():
     code = textwrap.dedent(
         """
         import jax, numpy as np, jaxcelt as jc
-        from jaxcelt.sweep import bifurcation
+        from jaxcelt.sweeps.sweep import bifurcation
         assert len(jax.local_devices()) == 2, jax.local_devices()
         p = jc.CeltParams.paper()
         v = np.array([12.0, 14.0, 17.0, 19.0])
@@ -230,7 +230,7 @@ def test_pool_other_solvers_equal_simulate(paper_params, solver):
     # on the samples and 3 % on the step count -- what "same method, same tolerance" means.
     import diffrax
 
-    from jaxcelt.sweep import SweepConfig, _erk_tableau
+    from jaxcelt.sweeps.sweep import SweepConfig, _erk_tableau
 
     s = getattr(diffrax, solver)()
     fused = _erk_tableau(SweepConfig(solver=s)) is not None
@@ -259,7 +259,7 @@ def test_pool_drain_compaction_keeps_lanes(paper_params):
     # with a pool that is 8 wide from the start. Different widths are different compiled programs
     # (on an AVX-512 CPU ~half the samples differ at <= 1.6e-12 relative), so: same step
     # counts and statuses, samples within SAMPLE_ATOL (see _sweep_common).
-    from jaxcelt.sweep import SweepConfig, run_lanes
+    from jaxcelt.sweeps.sweep import SweepConfig, run_lanes
 
     vals = np.linspace(12.0, 19.0, 40)
     y0 = np.tile(np.asarray(jc.initial_state(paper_params)), (len(vals), 1))
@@ -280,7 +280,7 @@ def test_wide_vector_pool_keeps_lanes(paper_params):
     # compiled programs that may round differently (on a CPU without AVX-512 they are the same).
     # Lanes must not depend on it: same step counts and statuses, samples within SAMPLE_ATOL.
     from jaxcelt._compile_options import WIDE_VECTORS_MIN_SLOTS, pool_compiler_options
-    from jaxcelt.sweep import SweepConfig, run_lanes
+    from jaxcelt.sweeps.sweep import SweepConfig, run_lanes
 
     W = WIDE_VECTORS_MIN_SLOTS
     assert pool_compiler_options("cpu", W) == {"xla_cpu_prefer_vector_width": 512}
@@ -303,7 +303,7 @@ def test_narrow_pool_inner_loop_keeps_lanes(paper_params):
     # once per iteration. Another width is another compiled program: same steps and statuses,
     # floats within SAMPLE_ATOL (min_N to rtol 1e-7, as in the pilot test below).
     from jaxcelt.ensemble.pool import SEQUENTIAL_WIDTH
-    from jaxcelt.sweep import SweepConfig, run_lanes
+    from jaxcelt.sweeps.sweep import SweepConfig, run_lanes
 
     # from rest, omega_pi = 10 and 10.5 need > 3000 steps to their first invalid state (~4.9
     # periods), 11.5 and 12.25 ~2100-2300 (~5.5-6 periods); 14-19 stay valid over 7 periods.
@@ -339,7 +339,7 @@ def test_pool_pilot_pause_keeps_lanes(paper_params):
     # run out of steps (max_steps: status 1) and lanes that stop invalid. The pilot is another
     # compiled program, so: same steps and statuses, floats within SAMPLE_ATOL (min_N to rtol
     # 1e-7: N is a stiff function of the state, see test_sweep_equals_single_simulate).
-    from jaxcelt.sweep import SweepConfig, run_lanes
+    from jaxcelt.sweeps.sweep import SweepConfig, run_lanes
 
     vals = np.linspace(10.0, 19.0, 40)
     y0 = np.tile(np.asarray(jc.initial_state(paper_params)), (len(vals), 1))
@@ -404,7 +404,7 @@ def test_parameter_map_resume(pmap, paper_params):
     )
     assert seen == [1]
     assert again.identical(ds)
-    from jaxcelt.dataset import open_sweep
+    from jaxcelt.sweeps.dataset import open_sweep
 
     assert open_sweep(out).identical(ds)
 
@@ -464,7 +464,7 @@ def test_map_cli_equals_api(tmp_path, paper_params):
     # `jaxcelt map` writes the dataset of jc.parameter_map with the same settings (1e-10: the CLI
     # runs on --host-devices 1 here but the compiled program may still differ, see _sweep_common),
     # plus summary.json and the figure
-    from jaxcelt.dataset import open_sweep
+    from jaxcelt.sweeps.dataset import open_sweep
 
     out = tmp_path / "m"
     cmd = [sys.executable, "-m", "jaxcelt", "map", "--x", "omega_pi=14,17", "--y", "q_pi=0.04,0.05", "--transient",
@@ -504,7 +504,7 @@ def test_two_processes_equal_one(paper_params, tmp_path):
     # samples within SAMPLE_ATOL (the processes compile their own programs; see _sweep_common).
     import socket
 
-    from jaxcelt.dataset import open_sweep
+    from jaxcelt.sweeps.dataset import open_sweep
 
     with socket.socket() as s:
         s.bind(("localhost", 0))
@@ -542,8 +542,8 @@ def test_two_processes_equal_one(paper_params, tmp_path):
 
 
 def open_sweep_regimes(result, params):
-    from jaxcelt.dataset import to_dataset
-    from jaxcelt.sweep import SweepConfig
+    from jaxcelt.sweeps.dataset import to_dataset
+    from jaxcelt.sweeps.sweep import SweepConfig
 
     cfg = SweepConfig(**{k: v for k, v in KW.items() if k != "chunk_size"})
     return to_dataset(result, params, cfg)["regime"].values
@@ -570,11 +570,11 @@ def test_float32_pool_over_300_periods(paper_params):
     apart) a float32 pool gives every lane the float64 pool's status. With float32 times every one
     of these lanes ended with a collapsed step (status 3); the pool now steps float32 lanes in float64
     time with the forcing phase from one period (`jaxcelt.ensemble.float64_times`,
-    `jaxcelt.model.field_time`). Statuses only: over 300 periods the chaotic lanes' samples part."""
+    `jaxcelt.physics.model.field_time`). Statuses only: over 300 periods the chaotic lanes' samples part."""
     om = np.repeat([15.0, 17.5, 20.0], 2)
     q = np.tile([0.04, 0.06], 3)
     kw = dict(transient_periods=270, sample_periods=30, stop_on_invalid=True, rtol=1e-6, atol=1e-8)
-    from jaxcelt.sweep import sweep_lanes
+    from jaxcelt.sweeps.sweep import sweep_lanes
 
     r64 = sweep_lanes(paper_params, {"omega_pi": om, "q_pi": q}, **kw)
     r32 = sweep_lanes(paper_params, {"omega_pi": om, "q_pi": q}, dtype="float32", **kw)
@@ -589,7 +589,7 @@ def test_sweep_lanes_any_batch_equals_bifurcation(base, paper_params, tmp_path):
     """`sweep_lanes` over an arbitrary batch (omega_pi and q_pi drawn per lane, shuffled, plus one
     lane with another start): each lane equals the `bifurcation` lane with the same parameters and
     start (another compiled program: same steps and status, samples within SAMPLE_ATOL)."""
-    from jaxcelt.sweep import sweep_lanes
+    from jaxcelt.sweeps.sweep import sweep_lanes
 
     om = np.array([17.0, 12.0, 19.0, 14.0, 17.0])
     q = np.array([0.04, 0.04, 0.04, 0.04, 0.05])
@@ -617,8 +617,8 @@ def test_orbit_equals_simulate(paper_params):
     # `orbit` (the phase plots' trajectories) is `simulate` stepping onto the save times, compiled
     # as its own program with XLA's loop emitters: the same steps, so states equal to rounding
     # (SAMPLE_ATOL, see _sweep_common), and the centre O of `centre_position` at every state.
-    from jaxcelt.diagnostics import centre_position
-    from jaxcelt.sweep import orbit
+    from jaxcelt.physics.diagnostics import centre_position
+    from jaxcelt.sweeps.sweep import orbit
 
     p = paper_params.replace(omega_pi=17.0)
     o = orbit(p, transient_periods=2, periods=3, points_per_period=8)
@@ -642,7 +642,7 @@ def test_prepare_orbit_compiles_the_program_orbit_runs(paper_params):
     # settings and another parameter value and start must run that program (one new executable in
     # the process's store, not two) and give what a fresh `simulate` gives (SAMPLE_ATOL).
     from jaxcelt import _executable_cache as ec
-    from jaxcelt.sweep import orbit, prepare_orbit
+    from jaxcelt.sweeps.sweep import orbit, prepare_orbit
 
     kw = dict(transient_periods=1, periods=2, points_per_period=5)
     p1, p2 = paper_params.replace(omega_pi=14.0), paper_params.replace(omega_pi=16.0)

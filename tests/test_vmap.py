@@ -2,7 +2,7 @@
 
 * A vmapped batch of 64 parameter sets (and initial states) equals 64 single runs to 1e-11 (identical step sequences; rounding only).
 * New parameter values, initial states, t1, save times and tolerances do not retrace the solve.
-  Detection: `jaxcelt.solve` builds its diffrax term from the module-level `vector_field`, which
+  Detection: `jaxcelt.integrate.solve` builds its diffrax term from the module-level `vector_field`, which
   Python calls only while JAX traces the solve; the test swaps it for
   ``eqx.debug.assert_max_traces(vector_field, max_traces=0)``, so any retrace of the simulate
   path raises. Positive controls (a new batch size must retrace) prove the detectors work.
@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import jaxcelt as jc
-import jaxcelt.solve as jsolve
+import jaxcelt.integrate.solve as jsolve
 
 B = 64
 T1 = 0.3

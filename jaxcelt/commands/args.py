@@ -70,7 +70,7 @@ def floats(n: int):
 def value_range(s: str):
     """``START:STOP:COUNT`` (COUNT evenly spaced values, ends included) or a list ``a,b,c``; ``''`` is empty.
 
-    Returns a NumPy array (the same values as `jaxcelt.sweep.parse_range`)."""
+    Returns a NumPy array (the same values as `jaxcelt.sweeps.sweep.parse_range`)."""
     import numpy as np
 
     if ":" in s:

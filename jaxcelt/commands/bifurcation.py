@@ -13,11 +13,20 @@ import json
 import time
 from pathlib import Path
 
-from .args import UsageError, floats, nonnegative_int, override, overrides, positive_float, positive_int, value_range
+from jaxcelt.commands.args import (
+    UsageError,
+    floats,
+    nonnegative_int,
+    override,
+    overrides,
+    positive_float,
+    positive_int,
+    value_range,
+)
 
 ENGINES = ("auto", "pool", "kernel")
 """`jaxcelt.ensemble.ENGINES`, written out: the CLI parses its arguments before it imports JAX"""
-SWEEP_SOLVERS = ("Tsit5", "Dopri5", "Dopri8")  # names in jaxcelt.benchmarking.SOLVERS
+SWEEP_SOLVERS = ("Tsit5", "Dopri5", "Dopri8")  # names in jaxcelt.studies.benchmarking.SOLVERS
 
 
 def register(sub) -> None:
@@ -76,7 +85,7 @@ def register(sub) -> None:
         "--width",
         type=positive_int,
         default=None,
-        help="pool slots per device: lanes stepped side by side (vmap width; default jaxcelt.sweep.DEFAULT_WIDTH)",
+        help="pool slots per device: lanes stepped side by side (vmap width; default jaxcelt.sweeps.sweep.DEFAULT_WIDTH)",
     )
     p.add_argument("--engine", default="auto", choices=ENGINES, help="how lanes are stepped: auto (the lane kernel on a GPU, the pool elsewhere), pool, or kernel (off a GPU it runs interpreted: for tests, slow)")
     p.add_argument(
@@ -109,7 +118,7 @@ def _ranges(ds, key: str = "regime") -> list[dict]:
     """Contiguous runs of equal (regime label, global motion) along the swept axis."""
     import numpy as np
 
-    from jaxcelt.regimes import GLOBAL_MOTION, regime_names
+    from jaxcelt.sweeps.regimes import GLOBAL_MOTION, regime_names
 
     name = ds.attrs["swept_parameter"]
     vals = ds[name].values
@@ -137,7 +146,7 @@ def regime_ranges(ds) -> list[tuple[float, float, int, str]]:
     The label is the local regime with the global motion of O (``"period-1, bounded"``), or
     ``"invalid"`` for a lane that left the model's validity (its global motion is unknown).
     A multi-start dataset is labelled by its first start."""
-    from jaxcelt.regimes import GLOBAL_MOTION, regime_names
+    from jaxcelt.sweeps.regimes import GLOBAL_MOTION, regime_names
 
     vals = ds[ds.attrs["swept_parameter"]].values
     reg, per, glob = ds["regime"].values, ds["period"].values, ds["global_motion"].values
@@ -161,7 +170,7 @@ def format_summary(ds, *, wall_seconds: float, out: Path, files: list[str], max_
 
     import numpy as np
 
-    from jaxcelt.solve import INVALID_KINDS
+    from jaxcelt.integrate.solve import INVALID_KINDS
 
     name = ds.attrs["swept_parameter"]
     vals = ds[name].values
@@ -204,7 +213,7 @@ def format_summary(ds, *, wall_seconds: float, out: Path, files: list[str], max_
         lines.append(f"largest Lyapunov exponent: {np.nanmin(lam):.3g} .. {np.nanmax(lam):.3g} 1/s")
     lines.append(f"wrote {out}/: " + ", ".join(files))
     lines.append(
-        f"load: from jaxcelt.dataset import open_sweep; ds = open_sweep({str(out)!r})  "
+        f"load: from jaxcelt.sweeps.dataset import open_sweep; ds = open_sweep({str(out)!r})  "
         f"# xarray.Dataset: ds.section, ds.regime, ds.lyapunov over ds.{name}"
     )
     return "\n".join(lines)
@@ -264,7 +273,7 @@ def run_settings(args, wall: float, devices=None) -> dict:
     """The settings and wall time of a sweep command (``bifurcation``, ``map``) for its summary.json."""
     import jax
 
-    from jaxcelt.sweep import DEFAULT_WIDTH
+    from jaxcelt.sweeps.sweep import DEFAULT_WIDTH
 
     return {
         "transient_periods": args.transient,
@@ -287,10 +296,10 @@ def run(args) -> int:
     import numpy as np
 
     import jaxcelt as jc
-    from jaxcelt.benchmarking import make_solver
     from jaxcelt.commands._warnings import one_line_warnings
-    from jaxcelt.dataset import open_sweep
-    from jaxcelt.sweep import sweep
+    from jaxcelt.studies.benchmarking import make_solver
+    from jaxcelt.sweeps.dataset import open_sweep
+    from jaxcelt.sweeps.sweep import sweep
     from jaxcelt.versions import versions_string
 
     # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2), before any work
@@ -313,7 +322,7 @@ def run(args) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     solver = make_solver(args.solver)
     if _phase_plots(args):  # the phase plots' program: traced and compiled while the sweep leaves a core idle
-        from jaxcelt.sweep import prepare_orbit
+        from jaxcelt.sweeps.sweep import prepare_orbit
 
         pw = params.replace(omega_pi=float(args.orbits[0]))
         prepare_orbit(pw, jc.initial_state(pw, omega=omega0), **_orbit_settings(args, solver), defer=True)
@@ -374,7 +383,7 @@ def _figures(args, ds, params, omega0, solver) -> None:
     import numpy as np
 
     import jaxcelt as jc
-    from jaxcelt.sweep import orbit, prepare_orbit
+    from jaxcelt.sweeps.sweep import orbit, prepare_orbit
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

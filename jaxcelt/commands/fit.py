@@ -1,7 +1,7 @@
 """``jaxcelt fit data.npz ...`` or ``jaxcelt fit rec1.csv rec2.csv --guess mu=0.2``: identify
 contact parameters from measured records.
 
-A thin layer over `jaxcelt.fit` and `jaxcelt.data.load_data` / `load_csv`: parses options, shows a progress
+A thin layer over `jaxcelt.fit` and `jaxcelt.identify.records.load_data` / `load_csv`: parses options, shows a progress
 bar with the loss, prints the fitted values with 95% intervals, writes a JSON result and figures.
 """
 
@@ -11,7 +11,7 @@ import argparse
 import json
 from pathlib import Path
 
-from .args import UsageError, override, overrides, positive_float, positive_int
+from jaxcelt.commands.args import UsageError, override, overrides, positive_float, positive_int
 
 
 def floats_list(text: str) -> list[float]:
@@ -29,15 +29,15 @@ def register(sub) -> None:
     p = sub.add_parser(
         "fit",
         help="fit contact parameters to a measured-data file (.npz or .nc)",
-        description="Fit parameters of the model to measured trajectories (file format: jaxcelt.data).",
+        description="Fit parameters of the model to measured trajectories (file format: jaxcelt.identify.records).",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
     p.add_argument(
         "data",
         type=Path,
         nargs="+",
-        help="data file written by jaxcelt.data.save_data (.npz or .nc), or one CSV per record "
-        "(columns t, omega1..3, ...: jaxcelt.data.load_csv, docs/identification.md)",
+        help="data file written by jaxcelt.identify.records.save_data (.npz or .nc), or one CSV per record "
+        "(columns t, omega1..3, ...: jaxcelt.identify.records.load_csv, docs/identification.md)",
     )
     p.add_argument(
         "--guess",
@@ -70,10 +70,10 @@ def register(sub) -> None:
     p.add_argument("--fit-time-offset", action="store_true",
                    help="also fit each record's time offset (the base's phase at the record's t = 0)")  # fmt: skip
     p.add_argument("--spans", type=floats_list, default=None, metavar="S1,S2,...",
-                   help="fit the first S1 seconds of every record, then S2, ... (jaxcelt.fit.fit_staged)")  # fmt: skip
+                   help="fit the first S1 seconds of every record, then S2, ... (jaxcelt.identify.fit.fit_staged)")  # fmt: skip
     p.add_argument("--starts", type=positive_int, default=1,
-                   help="fit from this many starts (jaxcelt.fit.multistart: vmapped on a GPU): the guess and "
-                   "starts drawn within a factor 2 of it (jaxcelt.fit.random_guesses); reports the best fit and "
+                   help="fit from this many starts (jaxcelt.identify.fit.multistart: vmapped on a GPU): the guess and "
+                   "starts drawn within a factor 2 of it (jaxcelt.identify.fit.random_guesses); reports the best fit and "
                    "the spread")  # fmt: skip
     p.add_argument("--seed", type=int, default=0, help="seed of the random starts")
     p.add_argument("--max-iter", type=positive_int, default=100)
@@ -88,8 +88,8 @@ def run(args) -> int:
     from tqdm import tqdm
 
     import jaxcelt as jc
-    from jaxcelt.data import MeasuredData, load_csv, load_data
-    from jaxcelt.fit import fit, fit_staged, multistart, random_guesses
+    from jaxcelt.identify.fit import fit, fit_staged, multistart, random_guesses
+    from jaxcelt.identify.records import MeasuredData, load_csv, load_data
 
     # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2)
     params0 = jc.CeltParams.paper(**overrides(args.set))

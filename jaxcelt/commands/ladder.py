@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from .args import UsageError, positive_float
+from jaxcelt.commands.args import UsageError, positive_float
 
 
 def register(sub) -> None:
@@ -24,7 +24,14 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from jaxcelt.ladder import builtin_scenes, default_ladder, needed_state, recommend, results_table, run_ladder
+    from jaxcelt.studies.ladder import (
+        builtin_scenes,
+        default_ladder,
+        needed_state,
+        recommend,
+        results_table,
+        run_ladder,
+    )
 
     scenes = builtin_scenes(short=args.short)
     names = list(scenes) if args.scene == "all" else [args.scene]

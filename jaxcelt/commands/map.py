@@ -15,8 +15,17 @@ import os
 import time
 from pathlib import Path
 
-from .args import UsageError, floats, nonnegative_int, override, overrides, positive_float, positive_int, value_range
-from .bifurcation import ENGINES, SWEEP_SOLVERS, add_host_processes, lane_devices, run_settings
+from jaxcelt.commands.args import (
+    UsageError,
+    floats,
+    nonnegative_int,
+    override,
+    overrides,
+    positive_float,
+    positive_int,
+    value_range,
+)
+from jaxcelt.commands.bifurcation import ENGINES, SWEEP_SOLVERS, add_host_processes, lane_devices, run_settings
 
 
 def register(sub) -> None:
@@ -47,7 +56,7 @@ def register(sub) -> None:
         "--chunk-size", type=positive_int, default=600, help="lanes per jitted pool launch (unit of resumable writing)"
     )
     p.add_argument(
-        "--width", type=positive_int, default=None, help="pool slots per device (default jaxcelt.sweep.DEFAULT_WIDTH)"
+        "--width", type=positive_int, default=None, help="pool slots per device (default jaxcelt.sweeps.sweep.DEFAULT_WIDTH)"
     )
     p.add_argument("--engine", default="auto", choices=ENGINES, help="how lanes are stepped: auto (the lane kernel on a GPU, the pool elsewhere), pool, or kernel (off a GPU it runs interpreted: for tests, slow)")
     p.add_argument("--host-devices", default="auto",
@@ -107,8 +116,8 @@ def run(args) -> int:
     import numpy as np
 
     import jaxcelt as jc
-    from jaxcelt.benchmarking import make_solver
     from jaxcelt.commands._warnings import one_line_warnings
+    from jaxcelt.studies.benchmarking import make_solver
     from jaxcelt.versions import versions_string
 
     # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2), before any work

@@ -17,7 +17,15 @@ import json
 import time
 from pathlib import Path
 
-from .args import UsageError, finite_float, nonnegative_int, override, overrides, positive_float, positive_int
+from jaxcelt.commands.args import (
+    UsageError,
+    finite_float,
+    nonnegative_int,
+    override,
+    overrides,
+    positive_float,
+    positive_int,
+)
 
 
 def _window(s: str) -> tuple[float, float]:
@@ -67,9 +75,9 @@ def run(args) -> int:
     from tqdm.auto import tqdm
 
     import jaxcelt as jc
-    from jaxcelt.celt_orbit import ORBIT_STATUS
-    from jaxcelt.model import STATE_NAMES
-    from jaxcelt.orbit_continuation import branch_to_dict
+    from jaxcelt.orbits.branch import branch_to_dict
+    from jaxcelt.orbits.celt import ORBIT_STATUS
+    from jaxcelt.physics.model import STATE_NAMES
     from jaxcelt.versions import versions
 
     params = jc.CeltParams.paper(**(dict(omega_pi=args.omega_pi, q_pi=args.q_pi) | overrides(args.set)))

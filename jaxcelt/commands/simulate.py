@@ -7,7 +7,7 @@ import json
 import time
 from pathlib import Path
 
-from .args import finite_float, floats, override, overrides, positive_float, positive_int
+from jaxcelt.commands.args import finite_float, floats, override, overrides, positive_float, positive_int
 
 
 def register(sub) -> None:
@@ -44,7 +44,7 @@ def run(args) -> int:
     import numpy as np
 
     import jaxcelt as jc
-    from jaxcelt.io import save_trajectory
+    from jaxcelt.integrate.io import save_trajectory
 
     # a bad value raises ValueError naming the parameter: jaxcelt.cli prints it as one error line, exit 2
     params = jc.CeltParams.paper(**(dict(omega_pi=args.omega_pi, q_pi=args.q_pi) | overrides(args.set)))

@@ -13,39 +13,39 @@
   (`SweepConfig`), sharded over devices, through the pool or the kernel (`ENGINES`), with the
   optional Lyapunov stage.
 
-The user-facing sweeps (`jaxcelt.sweep`: `bifurcation`, `parameter_map`, ...) are built on it.
+The user-facing sweeps (`jaxcelt.sweeps.sweep`: `bifurcation`, `parameter_map`, ...) are built on it.
 The diffrax internals it mirrors live in `jaxcelt._diffrax_adapter`.
 """
 
-from .kernel import BLOCK as BLOCK
-from .kernel import kernel_supported as kernel_supported
-from .lanes import LaneMonitor as LaneMonitor
-from .lanes import LaneOutputs as LaneOutputs
-from .lanes import LaneState as LaneState
-from .lanes import lane_status as lane_status
-from .pool import DEFAULT_WIDTH as DEFAULT_WIDTH
-from .pool import MIN_DRAIN_WIDTH as MIN_DRAIN_WIDTH
-from .pool import PILOT_FRACTION as PILOT_FRACTION
-from .pool import PoolStats as PoolStats
-from .pool import lane_outputs as lane_outputs
-from .pool import run_pool as run_pool
-from .pool import split_lane_args as split_lane_args
-from .pool import start_lanes as start_lanes
-from .processes import HostProcesses as HostProcesses
-from .shard import device_mesh as device_mesh
-from .shard import pad_lanes as pad_lanes
-from .shard import shard_lanes as shard_lanes
-from .soa import blockwise as blockwise
-from .stepper import AbstractLaneStepper as AbstractLaneStepper
-from .stepper import DiffraxStepper as DiffraxStepper
-from .stepper import DiffraxStepState as DiffraxStepState
-from .stepper import FusedERKStepper as FusedERKStepper
-from .stepper import FusedStepState as FusedStepState
-from .stepper import erk_tableau as erk_tableau
-from .stepper import kernel_boundary as kernel_boundary
-from .stepper import make_stepper as make_stepper
-from .stroboscopic import ENGINES as ENGINES
-from .stroboscopic import SweepConfig as SweepConfig
-from .stroboscopic import lanes_params as lanes_params
-from .stroboscopic import run_lanes as run_lanes
-from .stroboscopic import run_lanes_with_stats as run_lanes_with_stats
+from jaxcelt.ensemble.kernel import BLOCK as BLOCK
+from jaxcelt.ensemble.kernel import kernel_supported as kernel_supported
+from jaxcelt.ensemble.lanes import LaneMonitor as LaneMonitor
+from jaxcelt.ensemble.lanes import LaneOutputs as LaneOutputs
+from jaxcelt.ensemble.lanes import LaneState as LaneState
+from jaxcelt.ensemble.lanes import lane_status as lane_status
+from jaxcelt.ensemble.pool import DEFAULT_WIDTH as DEFAULT_WIDTH
+from jaxcelt.ensemble.pool import MIN_DRAIN_WIDTH as MIN_DRAIN_WIDTH
+from jaxcelt.ensemble.pool import PILOT_FRACTION as PILOT_FRACTION
+from jaxcelt.ensemble.pool import PoolStats as PoolStats
+from jaxcelt.ensemble.pool import lane_outputs as lane_outputs
+from jaxcelt.ensemble.pool import run_pool as run_pool
+from jaxcelt.ensemble.pool import split_lane_args as split_lane_args
+from jaxcelt.ensemble.pool import start_lanes as start_lanes
+from jaxcelt.ensemble.processes import HostProcesses as HostProcesses
+from jaxcelt.ensemble.shard import device_mesh as device_mesh
+from jaxcelt.ensemble.shard import pad_lanes as pad_lanes
+from jaxcelt.ensemble.shard import shard_lanes as shard_lanes
+from jaxcelt.ensemble.soa import blockwise as blockwise
+from jaxcelt.ensemble.stepper import AbstractLaneStepper as AbstractLaneStepper
+from jaxcelt.ensemble.stepper import DiffraxStepper as DiffraxStepper
+from jaxcelt.ensemble.stepper import DiffraxStepState as DiffraxStepState
+from jaxcelt.ensemble.stepper import FusedERKStepper as FusedERKStepper
+from jaxcelt.ensemble.stepper import FusedStepState as FusedStepState
+from jaxcelt.ensemble.stepper import erk_tableau as erk_tableau
+from jaxcelt.ensemble.stepper import kernel_boundary as kernel_boundary
+from jaxcelt.ensemble.stepper import make_stepper as make_stepper
+from jaxcelt.ensemble.stroboscopic import ENGINES as ENGINES
+from jaxcelt.ensemble.stroboscopic import SweepConfig as SweepConfig
+from jaxcelt.ensemble.stroboscopic import lanes_params as lanes_params
+from jaxcelt.ensemble.stroboscopic import run_lanes as run_lanes
+from jaxcelt.ensemble.stroboscopic import run_lanes_with_stats as run_lanes_with_stats

@@ -6,7 +6,7 @@ device-to-host round trip for the while loop's predicate: ≈ 0.3 ms per pool it
 the width, so a lane that sticks to the base (10⁵–10⁶ stability-limited steps) takes minutes.
 Here every lane keeps its state in registers while a Pallas kernel (Triton backend) steps it:
 
-* the right-hand side is `jaxcelt.model.vector_field_and_normal` re-expressed on blocks of lanes
+* the right-hand side is `jaxcelt.physics.model.vector_field_and_normal` re-expressed on blocks of lanes
   (`jaxcelt.ensemble.soa.blockwise`), with what the varying parameters do not touch folded at
   trace time;
 * one step is `FusedERKStepper`'s algorithm (an explicit FSAL tableau, diffrax's PID controller
@@ -37,12 +37,12 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._types import Array
-from ..contact import get_contact_law
-from ..model import field_time, vector_field_and_normal
-from ..solve import MIN_STEP_ULPS
-from .soa import blockwise
-from .stepper import erk_tableau
+from jaxcelt._types import Array
+from jaxcelt.ensemble.soa import blockwise
+from jaxcelt.ensemble.stepper import erk_tableau
+from jaxcelt.integrate.solve import MIN_STEP_ULPS
+from jaxcelt.physics.contact.registry import get_contact_law
+from jaxcelt.physics.model import field_time, vector_field_and_normal
 
 __all__ = ["BLOCK", "kernel_supported", "make_segment", "run_kernel_lanes", "KERNEL_FIELDS"]
 
@@ -105,7 +105,7 @@ class _Segment:
         self.omega_of = lambda pv: params_of(pv).omega_pi
 
     def field_time(self, t: Array, pv: tuple[Array, ...]) -> Array:
-        """The time the field is evaluated at, in the state's dtype (`jaxcelt.model.field_time`): the
+        """The time the field is evaluated at, in the state's dtype (`jaxcelt.physics.model.field_time`): the
         kernel's times are float64; a float32 field gets the forcing phase from one period."""
         return field_time(t, self.omega_of(pv), self.dtype)
 

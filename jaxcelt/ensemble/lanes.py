@@ -15,8 +15,8 @@ import diffrax
 import equinox as eqx
 import jax.numpy as jnp
 
-from .._types import Array
-from ..solve import status_code
+from jaxcelt._types import Array
+from jaxcelt.integrate.solve import status_code
 
 __all__ = ["LaneState", "LaneMonitor", "LaneOutputs", "lane_status"]
 

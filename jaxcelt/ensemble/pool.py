@@ -37,9 +37,9 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
-from .._types import Array
-from .lanes import LaneOutputs, LaneState, lane_status
-from .stepper import AbstractLaneStepper
+from jaxcelt._types import Array
+from jaxcelt.ensemble.lanes import LaneOutputs, LaneState, lane_status
+from jaxcelt.ensemble.stepper import AbstractLaneStepper
 
 __all__ = [
     "PoolStats",
@@ -80,7 +80,7 @@ predicted remaining cost (``benchmarks/bench_schedule.py``)"""
 
 class PoolStats(eqx.Module):
     """How a pool ran. Inside the jitted pool: int32 counters of one device; from
-    `jaxcelt.sweep.run_lanes`: plain ints over all devices."""
+    `jaxcelt.sweeps.sweep.run_lanes`: plain ints over all devices."""
 
     iterations: Any
     """loop iterations (every iteration steps every slot once); over devices: the busiest one's"""

@@ -10,8 +10,8 @@ three quarters of the one-process time in 2 pinned processes, and varied less; w
 18.1 s in one process, and stopping lanes at invalid states 3.57 s against 3.69 s
 (``benchmarks/bench_processes.py`` -> docs/bifurcation/processes.json).
 
-`HostProcesses` is accepted wherever a sweep takes ``devices`` (`jaxcelt.sweep.sweep`,
-``bifurcation``, ``parameter_map``, `jaxcelt.sweep.run_lanes`): each chunk's lanes are dealt
+`HostProcesses` is accepted wherever a sweep takes ``devices`` (`jaxcelt.sweeps.sweep.sweep`,
+``bifurcation``, ``parameter_map``, `jaxcelt.sweeps.sweep.run_lanes`): each chunk's lanes are dealt
 round-robin to the workers (lane i to worker i mod n, as lanes are dealt to devices), each
 worker runs them through its own lane pool on its one core, and the results are put back in
 lane order. The workers are started at the first chunk and kept for the next ones (each
@@ -37,7 +37,7 @@ from typing import Any
 import jax
 import numpy as np
 
-from .pool import PoolStats
+from jaxcelt.ensemble.pool import PoolStats
 
 __all__ = ["HostProcesses"]
 
@@ -57,7 +57,7 @@ def _worker_main() -> None:
 
     import jax
 
-    from .stroboscopic import run_lanes_with_stats
+    from jaxcelt.ensemble.stroboscopic import run_lanes_with_stats
 
     conn = Connection(int(os.environ["JAXCELT_WORKER_FD"]))
     device = jax.local_devices()[:1]
@@ -165,7 +165,7 @@ class HostProcesses:
         self, pb: Any, y0b: Any, cfg: Any, *, pad_to: int | None, varying: tuple[str, ...], **kwargs: Any
     ) -> tuple[dict[str, np.ndarray], PoolStats]:
         """`jaxcelt.ensemble.run_lanes_with_stats` over the workers (lanes dealt round-robin)."""
-        from .stroboscopic import varying_names
+        from jaxcelt.ensemble.stroboscopic import varying_names
 
         pb = jax.tree_util.tree_map(np.asarray, pb)
         y0b = np.asarray(y0b, dtype=np.float64)

@@ -2,7 +2,7 @@
 
 A stepper advances a `LaneState` by one step of diffrax's integration loop: the solver step,
 ``PIDController`` inside ``ClipStepSizeController(step_ts=section times)`` inside
-`jaxcelt.solve.MinStepController` (as `simulate` builds it), diffeqsolve's
+`jaxcelt.integrate.solve.MinStepController` (as `simulate` builds it), diffeqsolve's
 first-step choice and end-of-interval clipping, the validity monitor and the stop-on-invalid
 event. Because the controller steps onto every section time, the end of an accepted step that
 lands on the next section time *is* that sample: ``step`` says when (``hit``).
@@ -35,13 +35,21 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._diffrax_adapter import clip_to_end, loop_init, loop_step, t1_clip_floor, wrap_term
-from .._types import Array
-from ..contact import AbstractContactLaw, get_contact_law
-from ..model import field_time, vector_field_and_normal
-from ..params import CeltParams
-from ..solve import MinStepController, MonitoredSolver, _Field, _fill_implicit_tols, invalid_kind, step_too_small
-from .lanes import LaneMonitor, LaneState
+from jaxcelt._diffrax_adapter import clip_to_end, loop_init, loop_step, t1_clip_floor, wrap_term
+from jaxcelt._types import Array
+from jaxcelt.ensemble.lanes import LaneMonitor, LaneState
+from jaxcelt.integrate.solve import (
+    MinStepController,
+    MonitoredSolver,
+    _Field,
+    _fill_implicit_tols,
+    invalid_kind,
+    step_too_small,
+)
+from jaxcelt.physics.contact.laws import AbstractContactLaw
+from jaxcelt.physics.contact.registry import get_contact_law
+from jaxcelt.physics.model import field_time, vector_field_and_normal
+from jaxcelt.physics.params import CeltParams
 
 __all__ = [
     "AbstractLaneStepper",
@@ -218,7 +226,7 @@ class FusedERKStepper(AbstractLaneStepper):
     y0 + sum_j a_ij k_j), y1 = y0 + sum b_i k_i, error sum e_i k_i, the RMS error ratio and
     factor clip(0.9 err^(-1/q), [1, 10] if accepted else [0.2, 0.9]) with q the error order
     diffrax gives its controller (Tsit5 5, Dopri8 8), the next step clipped onto the next
-    section time and onto t1, a collapsed step size ending the lane (`jaxcelt.solve.step_too_small`).
+    section time and onto t1, a collapsed step size ending the lane (`jaxcelt.integrate.solve.step_too_small`).
     The last stage is f(t1, y1) (FSAL); its normal force and
     denominator feed the validity monitor, so monitoring costs no extra evaluation
     (`MonitoredSolver` evaluates N once more per step). Without diffrax's generic stage loop,
@@ -263,7 +271,7 @@ class FusedERKStepper(AbstractLaneStepper):
         float64 = y0.dtype == jnp.float64
         for c, a in zip(np.asarray(tab.c, dtype=float).tolist(), tab.a_lower):
             yi = boundary(_combine(y0, a, ks))
-            # float32 lanes: the forcing phase from one period, not from t (`jaxcelt.model.field_time`)
+            # float32 lanes: the forcing phase from one period, not from t (`jaxcelt.physics.model.field_time`)
             ti = t0 + c * dt if float64 else field_time(t0, p.omega_pi, y0.dtype, c * dt)
             fi, aux = vector_field_and_normal(ti, yi, p, self.law)
             ks.append(fi * dts)
@@ -330,8 +338,8 @@ class FusedERKStepper(AbstractLaneStepper):
 def float64_times(lanes: LaneState, t1: Array) -> LaneState:
     """Lanes (a batch) with their times in float64 and the state as it is: how `FusedERKStepper` steps
     float32 lanes. In float32 time a lane's steps cannot shrink below ~10 ULPs of t (7.6e-5 s at
-    t = 120 s, `jaxcelt.solve.step_too_small`), which a lane sticking to the base needs; with the
-    field's forcing phase taken from one period (`jaxcelt.model.field_time`) the stage times stay
+    t = 120 s, `jaxcelt.integrate.solve.step_too_small`), which a lane sticking to the base needs; with the
+    field's forcing phase taken from one period (`jaxcelt.physics.model.field_time`) the stage times stay
     exact too. ``t1``: the lanes' last section times in float64 (from float64 omega_pi)."""
     f64 = jnp.float64
     st = lanes.step_state

@@ -5,7 +5,7 @@ omega_pi, k = 0 .. S-1 (`SweepConfig`); the stepper steps exactly onto them, so 
 solver states. `run_lanes` runs one chunk of lanes: padded and dealt round-robin over the
 devices (`jaxcelt.ensemble.shard`), through the pool (`jaxcelt.ensemble.pool`) in one jitted
 call per device, then the optional Lyapunov stage. Chunking, resumable writing and several
-processes are `jaxcelt.sweep`'s business.
+processes are `jaxcelt.sweeps.sweep`'s business.
 """
 
 from __future__ import annotations
@@ -21,17 +21,12 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .. import _config  # noqa: F401
-from .._compile_options import compiler_options, is_wide_pool, pool_compiler_options
-from .._executable_cache import compile_later, gc_paused, start_deferred
-from .._types import Array
-from ..contact import get_contact_law
-from ..diagnostics import centre_position
-from ..lyapunov import celt_lyapunov
-from ..params import PARAM_NAMES, CeltParams
-from ..solve import DEFAULT_SOLVER
-from .kernel import BLOCK, kernel_supported, make_segment, run_kernel_lanes
-from .pool import (
+from jaxcelt import _config  # noqa: F401
+from jaxcelt._compile_options import compiler_options, is_wide_pool, pool_compiler_options
+from jaxcelt._executable_cache import compile_later, gc_paused, start_deferred
+from jaxcelt._types import Array
+from jaxcelt.ensemble.kernel import BLOCK, kernel_supported, make_segment, run_kernel_lanes
+from jaxcelt.ensemble.pool import (
     DEFAULT_WIDTH,
     DRAIN_FACTOR,
     MIN_DRAIN_WIDTH,
@@ -42,8 +37,13 @@ from .pool import (
     split_lane_args,
     start_lanes,
 )
-from .shard import device_mesh, pad_lanes, shard_lanes
-from .stepper import AbstractLaneStepper, FusedERKStepper, erk_tableau, float64_times, make_stepper
+from jaxcelt.ensemble.shard import device_mesh, pad_lanes, shard_lanes
+from jaxcelt.ensemble.stepper import AbstractLaneStepper, FusedERKStepper, erk_tableau, float64_times, make_stepper
+from jaxcelt.integrate.lyapunov import celt_lyapunov
+from jaxcelt.integrate.solve import DEFAULT_SOLVER
+from jaxcelt.physics.contact.registry import get_contact_law
+from jaxcelt.physics.diagnostics import centre_position
+from jaxcelt.physics.params import PARAM_NAMES, CeltParams
 
 __all__ = ["SweepConfig", "lanes_params", "run_lanes", "run_lanes_with_stats", "ENGINES"]
 
@@ -151,7 +151,7 @@ def _section_times(pb: CeltParams, transient: Array, cfg: SweepConfig) -> Array:
 
 
 def _lyap_lane(p: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig) -> tuple[Array, Array]:
-    """(lambda_1, its batch-means standard error) of one lane [1/s] (`jaxcelt.lyapunov.exponent_stderr`)."""
+    """(lambda_1, its batch-means standard error) of one lane [1/s] (`jaxcelt.integrate.lyapunov.exponent_stderr`)."""
     lr = celt_lyapunov(
         p,
         y_start,
@@ -302,7 +302,7 @@ def run_lanes_with_stats(
     ``devices`` may be a `jaxcelt.ensemble.HostProcesses`: the lanes then run in its worker
     processes, one per CPU core. ``engine``: `ENGINES` (the kernel's `PoolStats` count its loop
     iterations, one per step of its slowest lane, with ``width`` = `BLOCK`)."""
-    from .processes import HostProcesses
+    from jaxcelt.ensemble.processes import HostProcesses
 
     check_engine(engine, cfg.solver)
 
@@ -450,7 +450,7 @@ def run_lanes(
     so that all chunks of a sweep compile to one kernel; the others are constants of the
     pool's step.
 
-    Returns the fields of `jaxcelt.sweep.SweepResult` but ``values`` (lane axis first), and the pool's
+    Returns the fields of `jaxcelt.sweeps.sweep.SweepResult` but ``values`` (lane axis first), and the pool's
     statistics copied into every lane: ``pool_iterations``, ``pool_slot_steps``,
     ``pool_width`` (`run_lanes_with_stats` returns them apart, as `PoolStats`).
     """

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..diagnostics import centre_position
-from ..model import horizontal_frame
-from ..params import CeltParams
+from jaxcelt.physics.diagnostics import centre_position
+from jaxcelt.physics.model import horizontal_frame
+from jaxcelt.physics.params import CeltParams
 
 
 def body_to_global(y, params: CeltParams):

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from .bifurcation import REGIME_COLOURS
+from jaxcelt.plotting.bifurcation import REGIME_COLOURS
 
 __all__ = ["plot_basins", "attractor_colours"]
 

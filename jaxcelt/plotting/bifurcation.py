@@ -40,7 +40,7 @@ def bifurcation_figure(
     title: str = "",
     lyapunov_band: float = 0.02,
 ):
-    """Fig. 3-style diagram from a sweep dataset (`jaxcelt.dataset.to_dataset`/`open_sweep`).
+    """Fig. 3-style diagram from a sweep dataset (`jaxcelt.sweeps.dataset.to_dataset`/`open_sweep`).
 
     Args:
         ds: xarray Dataset with ``section`` (value, [start,] sample, state), ``regime``,
@@ -59,7 +59,7 @@ def bifurcation_figure(
     import matplotlib.pyplot as plt
     from matplotlib.lines import Line2D
 
-    from ..regimes import REGIMES
+    from jaxcelt.sweeps.regimes import REGIMES
 
     name = ds.attrs.get("swept_parameter", "omega_pi")
     sec = ds["section"].sel(state=component).values

@@ -9,7 +9,7 @@ __all__ = ["plot_error_maps", "plot_cost_vs_error", "plot_convergence"]
 
 
 def plot_error_maps(maps: dict, *, title: str = "", vmax: float | None = None):
-    """maps: {label: `jaxcelt.calibrate.error_map` dict}. One panel per label: |error| over
+    """maps: {label: `jaxcelt.physics.contact.calibrate.error_map` dict}. One panel per label: |error| over
     alpha = atan2(omega_s, |v_s|) (x) and slip direction beta (y), log colour scale."""
     n = len(maps)
     fig, axes = plt.subplots(1, n, figsize=(3.6 * n + 1, 3.6), sharey=True, squeeze=False, layout="constrained")

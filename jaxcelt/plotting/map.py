@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..regimes import REGIMES
-from .bifurcation import REGIME_COLOURS
+from jaxcelt.plotting.bifurcation import REGIME_COLOURS
+from jaxcelt.sweeps.regimes import REGIMES
 
 __all__ = ["map_figure", "map_categories", "PARAM_LABELS"]
 

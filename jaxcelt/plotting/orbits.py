@@ -28,7 +28,7 @@ _LABELS = {
 
 
 def _component_index(component: str) -> int:
-    from ..model import STATE_NAMES
+    from jaxcelt.physics.model import STATE_NAMES
 
     if component not in STATE_NAMES:
         raise ValueError(f"component must be one of {STATE_NAMES}, got {component!r}")
@@ -59,7 +59,7 @@ def branch_figure(
     """Combined diagram: brute-force section points with continued orbit branches on top.
 
     Args:
-        branches: `jaxcelt.orbit_continuation.ArclengthBranch` objects (``values``, ``y``,
+        branches: `jaxcelt.orbits.branch.ArclengthBranch` objects (``values``, ``y``,
             ``stable``, ``bifurcations``). A period-k branch may be given once per section point
             (the same branch with ``y`` of the j-th iterate), with the same label.
         labels: legend label of each branch (default "branch i").

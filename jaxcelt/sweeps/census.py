@@ -1,13 +1,13 @@
 """Attractor census of the forced wobblestone: many starts, one forcing frequency, distinct attractors.
 
-Every start state is one lane of `jaxcelt.sweep` (same parameters, ``y0`` per lane). After
+Every start state is one lane of `jaxcelt.sweeps.sweep` (same parameters, ``y0`` per lane). After
 ``transient_periods`` forcing periods each lane is sampled on the stroboscopic section for
-``sample_periods`` periods and labelled by `jaxcelt.regimes.classify`:
+``sample_periods`` periods and labelled by `jaxcelt.sweeps.regimes.classify`:
 
 * ``periodic`` with period k (the smallest k with x_{j+k} = x_j on the section, to ``tol``);
 * ``chaotic`` / ``quasi-periodic`` / ``converging`` (a negative exponent: attracted to a periodic
   orbit not yet reached) / ``uncertain`` by the largest Lyapunov exponent and its standard error
-  when the sweep computed it (``lyapunov_periods > 0``; `jaxcelt.regimes.classify`), else
+  when the sweep computed it (``lyapunov_periods > 0``; `jaxcelt.sweeps.regimes.classify`), else
   ``aperiodic`` (not periodic up to ``sample_periods // 2``, not further resolved: possibly
   still in its transient);
 * ``invalid`` (the model left its validity: lift-off, n3 <= 0) and ``failed`` (the solve did
@@ -35,10 +35,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .params import CeltParams
-from .regimes import REGIMES, classify
-from .state import initial_state
-from .sweep import sweep
+from jaxcelt.physics.params import CeltParams
+from jaxcelt.physics.state import initial_state
+from jaxcelt.sweeps.regimes import REGIMES, classify
+from jaxcelt.sweeps.sweep import sweep
 
 __all__ = [
     "AttractorStarts",
@@ -167,7 +167,7 @@ class Attractor:
     """One row of the census table.
 
     kind: ``periodic``, ``converging``, ``quasi-periodic``, ``chaotic``, ``uncertain``, ``aperiodic``,
-    ``invalid`` or ``failed`` (`jaxcelt.regimes.REGIMES`);
+    ``invalid`` or ``failed`` (`jaxcelt.sweeps.regimes.REGIMES`);
     k: period (0 unless periodic); state: representative section state (13,) (last sample of
     the representative lane; nan if none finite); t_section: its time [s]; lane: that lane;
     count, fraction: lanes in the row and their share of all lanes; lyapunov: median exponent
@@ -298,20 +298,20 @@ def attractors(
     refine_options: dict[str, Any] | None = None,
     **sweep_options: Any,
 ) -> AttractorCensus:
-    """Census of the attractors reached from ``starts`` at ``params`` (one `jaxcelt.sweep`).
+    """Census of the attractors reached from ``starts`` at ``params`` (one `jaxcelt.sweeps.sweep`).
 
     Args:
         params: the stone and the base (a single parameter set).
         starts: `AttractorStarts` or states (N, 13).
         transient_periods, sample_periods: forcing periods discarded, then sampled on the section
             (periods up to sample_periods // 2 are detected).
-        tol: period detection tolerance (`jaxcelt.regimes.detect_period`).
+        tol: period detection tolerance (`jaxcelt.sweeps.regimes.detect_period`).
         group_tol: tolerance of `same_cycle` for grouping periodic lanes (looser than ``tol``:
             lanes approach the orbit at different rates).
         chaos_threshold: [1/s] exponent separating chaotic from quasi-periodic lanes.
         refine: refine each periodic attractor with `jaxcelt.periodic_orbit` (multipliers).
         refine_options: keyword arguments of `periodic_orbit`.
-        sweep_options: further `jaxcelt.sweep` options (``lyapunov_periods``, ``rtol``, ``width``,
+        sweep_options: further `jaxcelt.sweeps.sweep` options (``lyapunov_periods``, ``rtol``, ``width``,
             ``chunk_size``, ``out``, ...).
     """
     if not isinstance(params, CeltParams):
@@ -425,7 +425,7 @@ def refine_attractor(params: CeltParams, a: Attractor, **options: Any) -> Attrac
     decreasing) and ``stable``; an exception is caught and reported in ``refine_status``.
     ``options``: keyword arguments of `periodic_orbit`. Returns ``a``.
     """
-    from .celt_orbit import periodic_orbit
+    from jaxcelt.orbits.celt import periodic_orbit
 
     if a.kind != "periodic":
         raise ValueError(f"refine_attractor: 'a' must be a periodic attractor, got kind {a.kind!r}")

@@ -7,9 +7,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .model import STATE_NAMES
-from .params import CeltParams
-from .versions import versions
+from jaxcelt.physics.model import STATE_NAMES
+from jaxcelt.physics.params import CeltParams
+from jaxcelt.versions import versions
 
 
 def save_trajectory(

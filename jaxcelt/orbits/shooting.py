@@ -31,8 +31,8 @@ import jax
 import jax.numpy as jnp
 import optimistix as optx
 
-from . import _config  # noqa: F401
-from ._types import Array, Scalar
+from jaxcelt import _config  # noqa: F401
+from jaxcelt._types import Array, Scalar
 
 __all__ = [
     "ORBIT_STATUS",

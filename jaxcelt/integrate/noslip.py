@@ -31,11 +31,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from . import _config  # noqa: F401
-from ._types import Array, ArrayLike, Scalar, ScalarLike, Vec3
-from .model import contact_geometry, horizontal_frame
-from .params import CeltParams
-from .solve import Solution, Validity, status_code
+from jaxcelt import _config  # noqa: F401
+from jaxcelt._types import Array, ArrayLike, Scalar, ScalarLike, Vec3
+from jaxcelt.integrate.solve import Solution, Validity, status_code
+from jaxcelt.physics.model import contact_geometry, horizontal_frame
+from jaxcelt.physics.params import CeltParams
 
 __all__ = [
     "NOSLIP_STATE_NAMES",

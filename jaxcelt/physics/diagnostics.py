@@ -7,11 +7,12 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from ._types import Array, Scalar, ScalarLike, State
-from .contact import AbstractContactLaw, get_contact_law
-from .model import contact_geometry, horizontal_frame, normal_force
-from .params import CeltParams
-from .state import constraint_residual
+from jaxcelt._types import Array, Scalar, ScalarLike, State
+from jaxcelt.physics.contact.laws import AbstractContactLaw
+from jaxcelt.physics.contact.registry import get_contact_law
+from jaxcelt.physics.model import contact_geometry, horizontal_frame, normal_force
+from jaxcelt.physics.params import CeltParams
+from jaxcelt.physics.state import constraint_residual
 
 __all__ = ["energy", "tilt", "centre_position", "Diagnostics", "diagnostics"]
 

@@ -42,12 +42,13 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from . import _config  # noqa: F401
-from ._diffrax_adapter import solve_to
-from ._types import Array, Scalar
-from .contact import AbstractContactLaw, get_contact_law
-from .model import contact_geometry, vector_field
-from .params import CeltParams
+from jaxcelt import _config  # noqa: F401
+from jaxcelt._diffrax_adapter import solve_to
+from jaxcelt._types import Array, Scalar
+from jaxcelt.physics.contact.laws import AbstractContactLaw
+from jaxcelt.physics.contact.registry import get_contact_law
+from jaxcelt.physics.model import contact_geometry, vector_field
+from jaxcelt.physics.params import CeltParams
 
 __all__ = [
     "LyapunovResult",

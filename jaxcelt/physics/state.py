@@ -6,9 +6,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._types import ArrayLike, State
-from .model import contact_geometry, horizontal_frame
-from .params import CeltParams
+from jaxcelt._types import ArrayLike, State
+from jaxcelt.physics.model import contact_geometry, horizontal_frame
+from jaxcelt.physics.params import CeltParams
 
 __all__ = ["initial_state", "check_state", "constraint_residual", "MANIFOLD_TOL"]
 

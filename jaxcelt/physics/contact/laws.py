@@ -24,10 +24,10 @@ from typing import NamedTuple
 import equinox as eqx
 import jax.numpy as jnp
 
-from . import _math
-from ._types import Array, Scalar, ScalarLike
-from .elliptic import contact_integrals
-from .params import CeltParams
+from jaxcelt import _math
+from jaxcelt._types import Array, Scalar, ScalarLike
+from jaxcelt.physics.contact.elliptic import contact_integrals
+from jaxcelt.physics.params import CeltParams
 
 __all__ = [
     "AbstractContactLaw",
@@ -38,9 +38,6 @@ __all__ = [
     "CoulombSpin",
     "Coulomb",
     "pade_friction",
-    "law_name",
-    "CONTACT_LAWS",
-    "get_contact_law",
     "safe_abs_pow",
 ]
 
@@ -270,37 +267,3 @@ class Coulomb(AbstractContactLaw):
     def friction(self, kin, d_c, d_s, p):
         V = jnp.sqrt(kin.vsx**2 + kin.vsy**2 + p.eps)
         return kin.vsx / V, kin.vsy / V, jnp.zeros_like(kin.omega_s)
-
-
-CONTACT_LAWS: dict[str, type[AbstractContactLaw]] = {
-    "generalised_pade": GeneralisedPade,
-    "pade": Pade,
-    "coulomb_spin": CoulombSpin,
-    "coulomb": Coulomb,
-}
-"""Name -> law class. ``"integral"`` (`jaxcelt.integral_law.IntegralLaw`) is added when
-`jaxcelt.integral_law` is imported (always, via ``import jaxcelt``)."""
-
-
-def get_contact_law(law: str | AbstractContactLaw | None = None) -> AbstractContactLaw:
-    """Resolve a law given by object or by name (``None`` -> the paper's `GeneralisedPade`)."""
-    if law is None:
-        return GeneralisedPade()
-    if isinstance(law, AbstractContactLaw):
-        return law
-    if isinstance(law, str):
-        # "name" or "name:norr" (rolling resistance off).
-        name = law.lower().replace("-", "_")
-        name, _, opt = name.partition(":")
-        if name not in CONTACT_LAWS or opt not in ("", "rr", "norr"):
-            raise ValueError(f"unknown contact law {law!r}; known: {sorted(CONTACT_LAWS)} (optionally ':norr')")
-        return CONTACT_LAWS[name](rolling_resistance=opt != "norr")
-    raise TypeError(f"contact_law must be a name or an AbstractContactLaw, got {type(law).__name__}")
-
-
-def law_name(law: AbstractContactLaw) -> str:
-    """Short name of a law object, ``"name"`` or ``"name:norr"`` (inverse of `get_contact_law`)."""
-    for name, cls in CONTACT_LAWS.items():
-        if type(law) is cls:
-            return name if law.rolling_resistance else f"{name}:norr"
-    return type(law).__name__

@@ -13,7 +13,7 @@ with psi determine the dynamics; r_C does not feed back):
 * ``period-k`` -- smallest k <= ``max_period`` with max_j |x_{j+k} - x_j| <= tol (1 + max|x|)
   over the samples; k = 1 is the forcing period (a period-1 orbit of the stroboscopic map);
 * otherwise, from the largest Lyapunov exponent lambda_1 and, where it comes with one, its
-  standard error s (`jaxcelt.lyapunov.exponent_stderr`; s = 0 if not given), with the interval
+  standard error s (`jaxcelt.integrate.lyapunov.exponent_stderr`; s = 0 if not given), with the interval
   [lo, hi] = lambda_1 -+ ``confidence`` s and th = ``chaos_threshold`` [1/s]:
 
   - ``chaotic``        -- lo > th;

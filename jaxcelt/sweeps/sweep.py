@@ -96,19 +96,20 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from . import _config  # noqa: F401
-from ._compile_options import compiler_options
-from ._executable_cache import compile_in_background, compiled
-from .contact import AbstractContactLaw, get_contact_law
-from .diagnostics import centre_position
-from .ensemble import DEFAULT_WIDTH as DEFAULT_WIDTH
-from .ensemble import MIN_DRAIN_WIDTH as MIN_DRAIN_WIDTH
-from .ensemble import PILOT_FRACTION as PILOT_FRACTION
-from .ensemble.stroboscopic import SweepConfig, check_engine, lanes_params, run_lanes, run_lanes_with_stats
-from .ensemble.stroboscopic import _erk_tableau as _erk_tableau  # noqa: F401  (tests)
-from .params import PARAM_NAMES, CeltParams
-from .solve import DEFAULT_SOLVER, simulate
-from .state import check_state, initial_state
+from jaxcelt import _config  # noqa: F401
+from jaxcelt._compile_options import compiler_options
+from jaxcelt._executable_cache import compile_in_background, compiled
+from jaxcelt.ensemble import DEFAULT_WIDTH as DEFAULT_WIDTH
+from jaxcelt.ensemble import MIN_DRAIN_WIDTH as MIN_DRAIN_WIDTH
+from jaxcelt.ensemble import PILOT_FRACTION as PILOT_FRACTION
+from jaxcelt.ensemble.stroboscopic import SweepConfig, check_engine, lanes_params, run_lanes, run_lanes_with_stats
+from jaxcelt.ensemble.stroboscopic import _erk_tableau as _erk_tableau  # noqa: F401  (tests)
+from jaxcelt.integrate.solve import DEFAULT_SOLVER, simulate
+from jaxcelt.physics.contact.laws import AbstractContactLaw
+from jaxcelt.physics.contact.registry import get_contact_law
+from jaxcelt.physics.diagnostics import centre_position
+from jaxcelt.physics.params import PARAM_NAMES, CeltParams
+from jaxcelt.physics.state import check_state, initial_state
 
 __all__ = [
     "SweepConfig",
@@ -146,7 +147,7 @@ class SweepResult(eqx.Module):
         num_steps: solver steps (main solve), (L,)
         lyapunov: largest Lyapunov exponent [1/s] (NaN if not computed / failed), (L,)
         lyapunov_stderr: its batch-means standard error over 4 sub-windows [1/s]
-            (`jaxcelt.lyapunov.exponent_stderr`; NaN where ``lyapunov`` is, or with < 4 periods), (L,)
+            (`jaxcelt.integrate.lyapunov.exponent_stderr`; NaN where ``lyapunov`` is, or with < 4 periods), (L,)
         r_O: global position of the geometric centre at the samples [m], (L, S, 3)
     """
 
@@ -350,7 +351,7 @@ def _run_batch(
 ) -> tuple[dict[str, np.ndarray] | None, Any]:
     """Chunking, resumable writing and the multi-process split of a batch of lanes, shared by
     `sweep`, `parameter_map` and `sweep_lanes`: (lane results in lane order or None on a process
-    other than 0 of a multi-process run, the `jaxcelt.dataset.SweepWriter` or None)."""
+    other than 0 of a multi-process run, the `jaxcelt.sweeps.dataset.SweepWriter` or None)."""
     if not np.all(np.asarray(pb_all.omega_pi) > 0):
         raise ValueError("stroboscopic sampling needs omega_pi > 0 in every lane")
     check_engine(engine, cfg.solver)
@@ -363,7 +364,7 @@ def _run_batch(
     writer = None
     done: dict[int, dict[str, np.ndarray]] = {}
     if out is not None:
-        from .dataset import SweepWriter
+        from jaxcelt.sweeps.dataset import SweepWriter
 
         writer = SweepWriter(
             out,
@@ -462,7 +463,7 @@ def sweep_lanes(
     )  # fmt: skip
     if lanes_out is None:
         return None
-    from .dataset import to_lanes_dataset
+    from jaxcelt.sweeps.dataset import to_lanes_dataset
 
     ds = to_lanes_dataset(lanes_out, lane_values=vals, params=params, config=cfg)
     if writer is not None:
@@ -507,7 +508,7 @@ def sweep(
         y0: initial state(s): None (at rest on the base, `initial_state`), (13,), (K, 13)
             (multi-start: every value from each of K states) or (L_v, K, 13).
         lyapunov_periods: > 0 also integrates the tangent dynamics for that many periods
-            after the transient (`jaxcelt.lyapunov.celt_lyapunov`) -> ``lyapunov`` [1/s].
+            after the transient (`jaxcelt.integrate.lyapunov.celt_lyapunov`) -> ``lyapunov`` [1/s].
         rtol, atol, max_steps, solver, contact_law, t0: as in `jaxcelt.simulate`.
         chunk_size: lanes per jitted solve, the unit of resumable writing (default: all
             lanes in one chunk).
@@ -520,7 +521,7 @@ def sweep(
             use rtol >= 1e-6; results come back as float64 arrays, the Lyapunov stage runs
             in float64). With the explicit solvers' fused step and in the lane kernel the times
             stay float64 and the field gets the forcing phase from one period
-            (`jaxcelt.model.field_time`); with other solvers float32 lanes step in float32
+            (`jaxcelt.physics.model.field_time`); with other solvers float32 lanes step in float32
             time, and a step below ~10 ULPs of t ends a lane (status 3). Part of the
             dataset's fingerprint.
         width: batch slots per device of the pool (default `DEFAULT_WIDTH`).
@@ -533,7 +534,7 @@ def sweep(
             `jaxcelt.HostProcesses`: worker processes, one pinned to each CPU core with one
             device each (`jaxcelt.ensemble.processes`).
         out: directory; write the dataset chunk by chunk there and resume a previous,
-            interrupted run of the same sweep (`jaxcelt.dataset`). Required when several
+            interrupted run of the same sweep (`jaxcelt.sweeps.dataset`). Required when several
             processes run the sweep together (`jax.distributed`; see the module docstring).
         progress: tqdm bar over lanes (with ETA).
         on_chunk: ``on_chunk(chunk_index, chunk_results)`` called after each chunk.
@@ -651,9 +652,9 @@ def parameter_map(
 
     Returns:
         `xarray.Dataset` with dims ``(x_name, y_name, [start,] sample, state)``: the variables of
-        a sweep dataset (`jaxcelt.dataset`: section samples, status, validity, ``lyapunov``
+        a sweep dataset (`jaxcelt.sweeps.dataset`: section samples, status, validity, ``lyapunov``
         [1/s] if ``lyapunov_periods > 0``, NaN otherwise) and the regime labels ``regime``,
-        ``period``, ``global_motion`` (`jaxcelt.regimes`). With ``out`` it is also written to
+        ``period``, ``global_motion`` (`jaxcelt.sweeps.regimes`). With ``out`` it is also written to
         ``out/sweep.nc``. In a multi-process run (`jax.distributed`), process 0 returns it and
         the others None.
     """
@@ -687,7 +688,7 @@ def parameter_map(
     )  # fmt: skip
     if lanes is None:  # a process other than 0 of a multi-process map
         return None
-    from .dataset import to_map_dataset
+    from jaxcelt.sweeps.dataset import to_map_dataset
 
     shape = (nx, ny, K) if multi else (nx, ny)
     lanes = {k: v.reshape(shape + v.shape[1:]) for k, v in lanes.items()}

@@ -31,8 +31,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from . import _config  # noqa: F401  (float64 on)
-from ._types import Array, Mat3
+from jaxcelt import _config  # noqa: F401  (float64 on)
+from jaxcelt._types import Array, Mat3
 
 __all__ = ["CeltParams", "PARAM_NAMES", "inertia_tensor"]
 

@@ -9,7 +9,7 @@ Layout of an output directory ``out/``::
     out/sweep.nc               the merged dataset, written when every chunk is done
 
 An interrupted sweep (killed process, power cut) is resumed by calling the same
-`jaxcelt.sweep`/`bifurcation` with the same ``out``: finished chunks are read back, the
+`jaxcelt.sweeps.sweep`/`bifurcation` with the same ``out``: finished chunks are read back, the
 missing ones computed. A chunk file is used only if it opens, belongs to this sweep (its
 fingerprint), holds this chunk's lanes (their indices) and every expected variable with the
 expected shape; a damaged one (torn write, bad copy, a file of another sweep or version) is
@@ -20,7 +20,7 @@ The merged dataset has dimensions ``(<param>, [start,] sample, state)`` and vari
 ``section`` (states at the stroboscopic times), ``t_section``, ``status``, ``valid``,
 ``first_invalid_t``, ``first_invalid_kind``, ``min_N``, ``max_tilt``, ``drift``,
 ``max_excursion``, ``num_steps``, ``lyapunov``, ``r_O``, ``y_final`` and the regime labels
-(`jaxcelt.regimes`). Its attributes hold the parameters, the reading switches, the solver,
+(`jaxcelt.sweeps.regimes`). Its attributes hold the parameters, the reading switches, the solver,
 its tolerances, the sweep settings and the package/JAX versions (as JSON strings where
 nested). Load it with `open_sweep` (or plain ``xarray.open_dataset``).
 """
@@ -37,9 +37,9 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from .model import STATE_NAMES
-from .params import CeltParams
-from .regimes import GLOBAL_MOTION, REGIMES, classify
+from jaxcelt.physics.model import STATE_NAMES
+from jaxcelt.physics.params import CeltParams
+from jaxcelt.sweeps.regimes import GLOBAL_MOTION, REGIMES, classify
 
 __all__ = ["SweepWriter", "to_dataset", "to_map_dataset", "open_sweep", "SWEEP_FILE", "DamagedChunkWarning"]
 
@@ -68,7 +68,7 @@ LANE_FIELDS = (
     "lyapunov_stderr",
     "r_O",
 )
-"""per-lane arrays of a sweep (the fields of `jaxcelt.sweep.SweepResult` but ``values``), in
+"""per-lane arrays of a sweep (the fields of `jaxcelt.sweeps.sweep.SweepResult` but ``values``), in
 dataset order; sweep.py imports this module, not the other way round"""
 
 _LANE_DIMS: dict[str, tuple[str, ...]] = {
@@ -113,7 +113,7 @@ def _jsonable(x: Any) -> Any:
 
 
 def _attrs(params: CeltParams, name: str, config: Any, n_starts: int) -> dict[str, Any]:
-    from .versions import versions
+    from jaxcelt.versions import versions
 
     pd = params.as_dict()
     cfg = config.attrs()
@@ -166,7 +166,7 @@ def _base_coords(n_samples: int) -> dict[str, Any]:
 
 
 def to_dataset(result: Any, params: CeltParams, config: Any, **classify_kwargs) -> xr.Dataset:
-    """An xarray Dataset from a `jaxcelt.sweep.SweepResult` (regime labels added)."""
+    """An xarray Dataset from a `jaxcelt.sweeps.sweep.SweepResult` (regime labels added)."""
     name = result.name
     vals = np.asarray(result.values)
     multi = vals.ndim == 2
@@ -189,7 +189,7 @@ def to_lanes_dataset(
     config: Any,
     **classify_kwargs,
 ) -> xr.Dataset:
-    """A dataset of an arbitrary batch of lanes (`jaxcelt.sweep.sweep_lanes`): dim ``lane``, each
+    """A dataset of an arbitrary batch of lanes (`jaxcelt.sweeps.sweep.sweep_lanes`): dim ``lane``, each
     varied parameter a coordinate along it."""
     n = len(lanes["status"])
     coords: dict[str, Any] = {"lane": np.arange(n), **_base_coords(lanes["samples"].shape[-2])}
@@ -238,7 +238,7 @@ def open_sweep(path: str | os.PathLike) -> xr.Dataset:
 
 
 class SweepWriter:
-    """Chunk-by-chunk writer with resume (used by `jaxcelt.sweep` when ``out`` is given)."""
+    """Chunk-by-chunk writer with resume (used by `jaxcelt.sweeps.sweep` when ``out`` is given)."""
 
     def __init__(self, out, *, params, name, lane_values, lane_y0, n_starts, config, chunks):
         self.dir = Path(out)

@@ -7,7 +7,7 @@ theta = theta0 + scale z), and -- with multiple shooting -- the initial states o
 Residuals r(z) (all dimensionless, stacked into one vector):
 
 * misfit: (h(y(t_j)) - d_j) / sigma for every sample j, observation kind and channel, times
-  sqrt(weight[kind]); h is the observation model (`jaxcelt.data.observe`);
+  sqrt(weight[kind]); h is the observation model (`jaxcelt.identify.records.observe`);
 * continuity (multiple shooting): (y_k(end of window k) - s_{k+1}) / state_scale times
   sqrt(continuity_weight), where s_{k+1} is the next window's (projected) initial state;
 * gauge (optimised window states): (s - P(s)) / state_scale times sqrt(continuity_weight), P the
@@ -51,15 +51,15 @@ import numpy as np
 import optax
 import optimistix as optx
 
-from . import _config  # noqa: F401
-from ._compile_options import compiler_options
-from ._diffrax_adapter import runtime_checks_as_nan
-from ._executable_cache import compile_in_background, compiled
-from ._types import Array, State
-from .data import OBSERVABLES, SENSOR_KINDS, MeasuredData, observe, rotation_matrix
-from .model import contact_geometry
-from .params import PARAM_NAMES, CeltParams
-from .solve import simulate
+from jaxcelt import _config  # noqa: F401
+from jaxcelt._compile_options import compiler_options
+from jaxcelt._diffrax_adapter import runtime_checks_as_nan
+from jaxcelt._executable_cache import compile_in_background, compiled
+from jaxcelt._types import Array, State
+from jaxcelt.identify.records import OBSERVABLES, SENSOR_KINDS, MeasuredData, observe, rotation_matrix
+from jaxcelt.integrate.solve import simulate
+from jaxcelt.physics.model import contact_geometry
+from jaxcelt.physics.params import PARAM_NAMES, CeltParams
 
 __all__ = [
     "fit",
@@ -918,7 +918,7 @@ def fit(
     """Fit the free parameters to measured trajectories.
 
     Args:
-        data: `jaxcelt.data.MeasuredData` (any observation kinds; several records, each with its
+        data: `jaxcelt.identify.records.MeasuredData` (any observation kinds; several records, each with its
             own omega_pi, q_pi).
         params0: starting parameters (also the values of every parameter that is not free).
         free: names of the parameters to fit (any float fields of `CeltParams` except the
@@ -937,7 +937,7 @@ def fit(
             its first projected full-state sample).
         sensor_rotation: rotation vector (3,) [rad] from body to sensor axes of the gyro
             (``"omega"``) and accelerometer (``"accel"``) observations: h_sensor = R h_body
-            (`jaxcelt.data.rotation_matrix`); default none. With ``fit_rotation`` it is the
+            (`jaxcelt.identify.records.rotation_matrix`); default none. With ``fit_rotation`` it is the
             starting value of a fitted rotation shared by all records.
         time_offset: model time minus record time [s] (scalar or one per record), i.e. the phase
             of the base's motion at the record's t = 0; default 0. With ``fit_time_offset`` the

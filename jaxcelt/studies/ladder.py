@@ -26,14 +26,15 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .contact import AbstractContactLaw, get_contact_law, law_name
-from .diagnostics import centre_position, energy, tilt
-from .integral_law import HERTZ_S, IntegralLaw
-from .model import STATE_NAMES, vector_field
-from .noslip import simulate_noslip
-from .params import CeltParams
-from .solve import simulate
-from .state import initial_state
+from jaxcelt.integrate.noslip import simulate_noslip
+from jaxcelt.integrate.solve import simulate
+from jaxcelt.physics.contact.integral import HERTZ_S, IntegralLaw
+from jaxcelt.physics.contact.laws import AbstractContactLaw
+from jaxcelt.physics.contact.registry import get_contact_law, law_name
+from jaxcelt.physics.diagnostics import centre_position, energy, tilt
+from jaxcelt.physics.model import STATE_NAMES, vector_field
+from jaxcelt.physics.params import CeltParams
+from jaxcelt.physics.state import initial_state
 
 __all__ = [
     "Scene",
@@ -55,7 +56,7 @@ HERTZ_CALIBRATED = {
     "generalised_pade": {"b_Ts": 0.070424, "b_Ms": 0.291419, "m_Ts": 0.672929, "m_Ms": 0.646714},
     "pade": {"b_Ts": 0.035863, "b_Ms": 0.113412},
 }
-"""Constants fitted by `jaxcelt.calibrate.calibrate` to the Hertz integral law at b = 0.1813
+"""Constants fitted by `jaxcelt.physics.contact.calibrate.calibrate` to the Hertz integral law at b = 0.1813
 with S_i fixed at the Hertz moments (regenerate with ``scripts/contact_study.py``)."""
 
 

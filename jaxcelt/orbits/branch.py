@@ -1,7 +1,7 @@
 """Natural-parameter continuation of periodic orbits of forced ODEs, with bifurcation detection.
 
 A branch of period-k orbits is followed in one scalar parameter lam over a given grid of
-values: each point is a Newton solve (`jaxcelt.periodic.find_periodic_orbit`, one compiled
+values: each point is a Newton solve (`jaxcelt.orbits.shooting.find_periodic_orbit`, one compiled
 program for the whole branch) from a secant prediction through the two previous points. The
 branch stops at the first point that does not converge (typically a fold, where natural
 continuation cannot pass).
@@ -28,8 +28,8 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
-from ._types import Array
-from .periodic import (
+from jaxcelt._types import Array
+from jaxcelt.orbits.shooting import (
     Chart,
     PeriodicOrbit,
     find_periodic_orbit,
@@ -285,7 +285,7 @@ def continue_pseudo_arclength(
             window (it may turn at folds and come back through lam0 on another sheet).
         ds, ds_min, ds_max: initial, smallest and largest arclength step in (z, lam).
         max_points: points at most (shared by the two ends of a window).
-        embed, chart: local coordinates as in `jaxcelt.periodic.find_periodic_orbit`
+        embed, chart: local coordinates as in `jaxcelt.orbits.shooting.find_periodic_orbit`
             (``embed(z, y_ref, args)``, ``chart(y, y_ref, args)``); default identity.
         solver: diffrax solver (default Dopri8).
         bisections: halvings of the lam-bracket of each period doubling (a Newton solve at

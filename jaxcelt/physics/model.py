@@ -6,7 +6,7 @@ Stages (each a pure function of one sample; batch with ``jax.vmap``), MODEL.md s
 2. `horizontal_frame`  -- global axes E1, E2 in body components from (n, psi) (eq. 6; section 4)
 3. `patch_frame`       -- contact-patch axes e_x, e_y (Fig. 2; section 5)
 4. `kinematics`        -- slip, spin and rolling velocities (eqs. 2, 16, 17; section 6)
-5. contact law         -- loads per unit N (`jaxcelt.contact`; section 7)
+5. contact law         -- loads per unit N (`jaxcelt.physics.contact.laws`; section 7)
 6. `normal_force`      -- N from the differentiated constraint d/dt(v_A . n) = 0 (section 8)
 7. `vector_field`      -- Newton-Euler, n_dot, r_C dot, psi dot (eqs. 1, 5, 6; section 8)
 
@@ -21,10 +21,11 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from ._math import cross3, matvec3, sincos
-from ._types import Scalar, ScalarLike, State, Vec3
-from .contact import AbstractContactLaw, ContactKinematics, ContactLoads, get_contact_law
-from .params import CeltParams
+from jaxcelt._math import cross3, matvec3, sincos
+from jaxcelt._types import Scalar, ScalarLike, State, Vec3
+from jaxcelt.physics.contact.laws import AbstractContactLaw, ContactKinematics, ContactLoads
+from jaxcelt.physics.contact.registry import get_contact_law
+from jaxcelt.physics.params import CeltParams
 
 __all__ = [
     "Frame",

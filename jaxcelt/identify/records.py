@@ -45,11 +45,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from . import _config  # noqa: F401
-from ._types import Array, ArrayLike, State
-from .diagnostics import centre_position
-from .model import vector_field
-from .params import CeltParams
+from jaxcelt import _config  # noqa: F401
+from jaxcelt._types import Array, ArrayLike, State
+from jaxcelt.physics.diagnostics import centre_position
+from jaxcelt.physics.model import vector_field
+from jaxcelt.physics.params import CeltParams
 
 __all__ = [
     "OBSERVABLES",
@@ -84,7 +84,7 @@ SENSOR_KINDS = ("omega", "accel")
 def rotation_matrix(rotvec: ArrayLike) -> Array:
     """Rotation matrix exp([r]x) of a rotation vector r (3,) [rad] (Rodrigues); differentiable at 0.
 
-    As the sensor rotation of `jaxcelt.fit.fit`: a vector with body components h has sensor
+    As the sensor rotation of `jaxcelt.identify.fit.fit`: a vector with body components h has sensor
     components R h."""
     r = jnp.asarray(rotvec, dtype=float)
     th2 = jnp.dot(r, r)
@@ -223,7 +223,7 @@ def generate_data(
         `MeasuredData`; ``meta`` records the true parameters and the settings; each trajectory
         stores its true ``y0`` (the release condition known to the experimenter).
     """
-    from .solve import simulate
+    from jaxcelt.integrate.solve import simulate
 
     y0s = np.atleast_2d(np.asarray(y0s, float))
     nt = len(y0s)
@@ -261,7 +261,7 @@ def generate_data(
         trajs.append(
             Trajectory(ts=ts, obs=obs, sigma=sig, omega_pi=float(omega_pis[i]), q_pi=float(p.q_pi), y0=y0s[i].copy())
         )
-    from .params import PARAM_NAMES
+    from jaxcelt.physics.params import PARAM_NAMES
 
     meta = dict(
         generator="jaxcelt.generate_data",

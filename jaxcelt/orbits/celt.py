@@ -33,13 +33,14 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
-from . import _config  # noqa: F401
-from ._types import Array, ArrayLike, Scalar
-from .contact import AbstractContactLaw, get_contact_law
-from .model import contact_geometry, horizontal_frame, vector_field
-from .params import CeltParams
-from .periodic import ORBIT_STATUS, find_periodic_orbit, sort_multipliers, stroboscopic_map
-from .state import check_state
+from jaxcelt import _config  # noqa: F401
+from jaxcelt._types import Array, ArrayLike, Scalar
+from jaxcelt.orbits.shooting import ORBIT_STATUS, find_periodic_orbit, sort_multipliers, stroboscopic_map
+from jaxcelt.physics.contact.laws import AbstractContactLaw
+from jaxcelt.physics.contact.registry import get_contact_law
+from jaxcelt.physics.model import contact_geometry, horizontal_frame, vector_field
+from jaxcelt.physics.params import CeltParams
+from jaxcelt.physics.state import check_state
 
 GUESS_MANIFOLD_TOL = 1e-3
 """How far (|n| - 1, v_A . n, r_C3 + rho . n) a guess may be off the contact manifold."""
@@ -219,7 +220,7 @@ def periodic_orbit(
 
     Newton (optimistix) on the stroboscopic map over k T = 2 pi k / omega_pi in the 8 chart
     coordinates of the contact manifold (`celt_chart`; r_C1, r_C2 excluded as cyclic, psi
-    included); Floquet multipliers from the variational equations (`jaxcelt.periodic`).
+    included); Floquet multipliers from the variational equations (`jaxcelt.orbits.shooting`).
     A good guess is the state after a long transient at t0 = m T (e.g. ``simulate`` with
     ``ts`` on the section). Vmappable over params / guesses (jit inside; lanes that fail get
     ``status`` 1 or 2, never an exception).
@@ -285,7 +286,7 @@ def continue_orbit(
     """Follow ``orbit`` (found at ``params``) in the parameter ``name`` to ``stop``.
 
     Pseudo-arclength continuation in the 8 chart coordinates of the contact manifold plus the
-    parameter (`jaxcelt.orbit_continuation.continue_pseudo_arclength`, the chart re-centred on
+    parameter (`jaxcelt.orbits.branch.continue_pseudo_arclength`, the chart re-centred on
     every point), so the branch passes folds; folds, period doublings (bisected) and
     Neimark-Sacker points are reported in ``bifurcations``. The section is t0 = 0 (the field
     depends on t only through the base's phase omega_pi t, so an orbit found at t0 = m T is the
@@ -303,9 +304,9 @@ def continue_orbit(
         callback: ``callback(n_points, value, accepted)`` after every corrector attempt.
 
     Returns:
-        `jaxcelt.orbit_continuation.ArclengthBranch` (``y``: states at the section t0 = 0).
+        `jaxcelt.orbits.branch.ArclengthBranch` (``y``: states at the section t0 = 0).
     """
-    from .orbit_continuation import continue_pseudo_arclength
+    from jaxcelt.orbits.branch import continue_pseudo_arclength
 
     if not isinstance(params, CeltParams):
         raise TypeError(f"params must be a CeltParams, got {type(params).__name__}")
@@ -373,7 +374,7 @@ def locate_orbit_bifurcation(
 ):
     """Refine a fold or period doubling of a wobblestone orbit in ``name``; differentiable in ``wrt``.
 
-    `jaxcelt.bifurcation_point.locate_bifurcation` in the chart of the contact manifold
+    `jaxcelt.orbits.points.locate_bifurcation` in the chart of the contact manifold
     (`celt_chart`, section t0 = 0): Newton on (periodicity, bordered det(M -+ I) = 0) for the
     orbit state and the value of ``name``. ``jax.grad`` of the result's ``value`` (or ``y``)
     with respect to the fields ``wrt`` of ``params`` is the implicit-function-theorem derivative
@@ -388,7 +389,7 @@ def locate_orbit_bifurcation(
         kind: ``"fold"`` (a multiplier at +1) or ``"period-doubling"`` (-1).
         wrt: the fields derivatives are carried for (the others are constants).
     """
-    from .bifurcation_point import locate_bifurcation
+    from jaxcelt.orbits.points import locate_bifurcation
 
     if not isinstance(params, CeltParams):
         raise TypeError(f"params must be a CeltParams, got {type(params).__name__}")

@@ -31,9 +31,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._types import Array, Scalar, ScalarLike
-from .contact import CONTACT_LAWS, AbstractContactLaw, ContactKinematics, ContactLoads
-from .params import CeltParams
+from jaxcelt._types import Array, Scalar, ScalarLike
+from jaxcelt.physics.contact.laws import AbstractContactLaw, ContactKinematics, ContactLoads
+from jaxcelt.physics.params import CeltParams
 
 __all__ = [
     "AbstractPressureProfile",
@@ -243,9 +243,6 @@ class IntegralLaw(AbstractContactLaw):
         """As the base class, with S3 of eq. (11) taken from the profile."""
         S3 = profile_moments(self.profile)["S3"]
         return super().loads(kin, e_x, e_y, n, eqx.tree_at(lambda q: q.S3, p, jnp.asarray(S3, dtype=float)))
-
-
-CONTACT_LAWS["integral"] = IntegralLaw
 
 
 def integral_law_batch(law: IntegralLaw, vsx, vsy, omega_s, b, d_c=0.0, d_s=0.0, eps=0.0):

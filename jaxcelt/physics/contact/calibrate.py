@@ -24,10 +24,18 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
-from ._types import Array
-from .contact import AbstractContactLaw, ContactKinematics, Coulomb, CoulombSpin, GeneralisedPade, Pade, pade_friction
-from .integral_law import HertzProfile, IntegralLaw, patch_integrals, profile_moments
-from .params import CeltParams
+from jaxcelt._types import Array
+from jaxcelt.physics.contact.integral import HertzProfile, IntegralLaw, patch_integrals, profile_moments
+from jaxcelt.physics.contact.laws import (
+    AbstractContactLaw,
+    ContactKinematics,
+    Coulomb,
+    CoulombSpin,
+    GeneralisedPade,
+    Pade,
+    pade_friction,
+)
+from jaxcelt.physics.params import CeltParams
 
 __all__ = [
     "SlipSamples",

@@ -10,7 +10,7 @@ friendly. Conventions are scipy's with m = e^2: ``K(e) == scipy.special.ellipk(e
 
 import jax.numpy as jnp
 
-from ._types import Array, ArrayLike, Float
+from jaxcelt._types import Array, ArrayLike, Float
 
 _AGM_ITERS = 14
 

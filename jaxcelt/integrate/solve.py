@@ -22,13 +22,14 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
-from . import _config  # noqa: F401
-from ._diffrax_adapter import use_stepsize_tol
-from ._types import Array, ArrayLike, Scalar
-from .contact import AbstractContactLaw, get_contact_law
-from .model import contact_loads, kinematics, normal_force_parts, vector_field
-from .params import CeltParams
-from .state import check_state
+from jaxcelt import _config  # noqa: F401
+from jaxcelt._diffrax_adapter import use_stepsize_tol
+from jaxcelt._types import Array, ArrayLike, Scalar
+from jaxcelt.physics.contact.laws import AbstractContactLaw
+from jaxcelt.physics.contact.registry import get_contact_law
+from jaxcelt.physics.model import contact_loads, kinematics, normal_force_parts, vector_field
+from jaxcelt.physics.params import CeltParams
+from jaxcelt.physics.state import check_state
 
 __all__ = ["simulate", "Solution", "MonitoredSolver", "Validity", "INVALID_KINDS", "STATUS", "DEFAULT_SOLVER"]
 
@@ -385,7 +386,7 @@ def simulate(
         max_steps: step budget; hitting it gives ``status == 1`` rather than an exception.
             A step size that collapses to a few ULPs of t ends the solve earlier, with
             ``status == 3`` (`MIN_STEP_ULPS`).
-        contact_law: a law object or name (`jaxcelt.contact.CONTACT_LAWS`); default the
+        contact_law: a law object or name (`jaxcelt.physics.contact.laws.CONTACT_LAWS`); default the
             paper's generalised Pade law (eq. 13).
         stop_on_invalid: end the solve at the first accepted step whose end state is invalid
             (lift-off or n3 <= 0). Otherwise the solve continues and the solution says where

@@ -34,12 +34,13 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
-from . import _config  # noqa: F401
-from ._diffrax_adapter import use_stepsize_tol
-from .contact import AbstractContactLaw, get_contact_law
-from .params import CeltParams
-from .solve import simulate
-from .state import initial_state
+from jaxcelt import _config  # noqa: F401
+from jaxcelt._diffrax_adapter import use_stepsize_tol
+from jaxcelt.integrate.solve import simulate
+from jaxcelt.physics.contact.laws import AbstractContactLaw
+from jaxcelt.physics.contact.registry import get_contact_law
+from jaxcelt.physics.params import CeltParams
+from jaxcelt.physics.state import initial_state
 
 __all__ = [
     "Scene",

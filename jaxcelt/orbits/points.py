@@ -6,7 +6,7 @@ augmented system
 
     F(y, lam; theta) = [ P(y) - y ; g(y, lam) ] = 0,
 
-with P the k-period stroboscopic map (`jaxcelt.periodic.stroboscopic_map`) and g a well-scaled
+with P the k-period stroboscopic map (`jaxcelt.orbits.shooting.stroboscopic_map`) and g a well-scaled
 test function of the monodromy M = dP/dy: the bordered determinant of A = M + s I (s = +1 for
 period doubling, -1 for a fold),
 
@@ -39,9 +39,9 @@ import jax.numpy as jnp
 import optimistix as optx
 from jax.flatten_util import ravel_pytree
 
-from . import _config  # noqa: F401
-from ._types import Array, Scalar
-from .periodic import Chart, sort_multipliers, stroboscopic_map
+from jaxcelt import _config  # noqa: F401
+from jaxcelt._types import Array, Scalar
+from jaxcelt.orbits.shooting import Chart, sort_multipliers, stroboscopic_map
 
 __all__ = [
     "BIFURCATION_POINT_KINDS",
@@ -108,14 +108,14 @@ def locate_bifurcation(
     Args:
         vector_field: ``f(t, y, args)``, T-periodic in t.
         y_guess, lam_guess: a nearby orbit state (at ``t0``) and parameter value, e.g. from
-            `jaxcelt.orbit_continuation.continue_periodic_orbit`.
+            `jaxcelt.orbits.branch.continue_periodic_orbit`.
         args_of: ``(lam, theta) -> args`` (traceable in both).
         period_of: ``args -> T`` (may depend on lam and theta).
         theta: pytree of float arrays, the parameters the point is differentiated in.
         kind: ``"period-doubling"`` (a multiplier at -1) or ``"fold"`` (+1).
-        k, t0, solver, rtol, atol, max_steps: as in `jaxcelt.periodic.stroboscopic_map`.
+        k, t0, solver, rtol, atol, max_steps: as in `jaxcelt.orbits.shooting.stroboscopic_map`.
         embed, chart: local coordinates around ``y_guess`` as in
-            `jaxcelt.periodic.find_periodic_orbit` (default identity); the periodicity condition
+            `jaxcelt.orbits.shooting.find_periodic_orbit` (default identity); the periodicity condition
             and the monodromy M are taken in them (a model with constraints or cyclic
             coordinates needs them: its trivial multipliers at 1 would make every point a fold).
         newton_tol: Newton tolerance on z = (y, lam) (optimistix rtol = atol).

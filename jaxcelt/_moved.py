@@ -1,0 +1,84 @@
+"""Module paths from before the topic packages, kept working for one release.
+
+``import jaxcelt.sweep`` or ``from jaxcelt.data import load_csv`` still works: each old path is a stand-in module
+whose attributes are looked up in the new place on first use, with a `DeprecationWarning` that names it. The stand-ins
+are made when ``jaxcelt`` is imported (`install`); nothing else in the package uses them.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+import types
+import warnings
+from collections.abc import Mapping
+from types import MappingProxyType
+
+__all__ = ["MOVED", "install"]
+
+MOVED: Mapping[str, tuple[str, ...]] = MappingProxyType(
+    {
+        # old module (under jaxcelt.)  -> new modules searched in order for a name
+        "params": ("jaxcelt.physics.params",),
+        "state": ("jaxcelt.physics.state",),
+        "model": ("jaxcelt.physics.model",),
+        "diagnostics": ("jaxcelt.physics.diagnostics",),
+        "contact": ("jaxcelt.physics.contact.laws", "jaxcelt.physics.contact.registry"),
+        "integral_law": ("jaxcelt.physics.contact.integral",),
+        "elliptic": ("jaxcelt.physics.contact.elliptic",),
+        "calibrate": ("jaxcelt.physics.contact.calibrate",),
+        "solve": ("jaxcelt.integrate.solve",),
+        "noslip": ("jaxcelt.integrate.noslip",),
+        "lyapunov": ("jaxcelt.integrate.lyapunov",),
+        "io": ("jaxcelt.integrate.io",),
+        "sweep": ("jaxcelt.sweeps.sweep",),
+        "dataset": ("jaxcelt.sweeps.dataset",),
+        "regimes": ("jaxcelt.sweeps.regimes",),
+        "attractors": ("jaxcelt.sweeps.census",),
+        "periodic": ("jaxcelt.orbits.shooting",),
+        "orbit_continuation": ("jaxcelt.orbits.branch",),
+        "bifurcation_point": ("jaxcelt.orbits.points",),
+        "celt_orbit": ("jaxcelt.orbits.celt",),
+        "data": ("jaxcelt.identify.records",),
+        "fit": ("jaxcelt.identify.fit",),
+        "ladder": ("jaxcelt.studies.ladder",),
+        "benchmarking": ("jaxcelt.studies.benchmarking",),
+    }
+)
+"""Old module name -> the modules that now hold its names (searched in order)."""
+
+
+def _stand_in(package: str, old: str, targets: tuple[str, ...]) -> types.ModuleType:
+    name = f"{package}.{old}"
+    module = types.ModuleType(name, f"Deprecated: moved to {', '.join(targets)}.")
+
+    def __getattr__(attr: str):
+        if attr.startswith("__"):
+            raise AttributeError(attr)
+        for target in targets:
+            mod = importlib.import_module(target)
+            if hasattr(mod, attr):
+                warnings.warn(
+                    f"{name} is deprecated and will be removed in the next release; "
+                    f"use {mod.__name__}.{attr} (or jaxcelt.{attr} where it is public)",
+                    DeprecationWarning,
+                    stacklevel=2,
+                )
+                return getattr(mod, attr)
+        raise AttributeError(f"module {name!r} has no attribute {attr!r} (it moved to {', '.join(targets)})")
+
+    module.__getattr__ = __getattr__  # type: ignore[method-assign]
+    return module
+
+
+def install(package: types.ModuleType) -> None:
+    """Register the stand-ins in `sys.modules`; set them as attributes where the package has no name of its own.
+
+    ``jaxcelt.fit``, ``jaxcelt.attractors`` and ``jaxcelt.diagnostics`` stay the functions of those names, while
+    ``from jaxcelt.fit import FitResult`` still finds the stand-in.
+    """
+    for old, targets in MOVED.items():
+        name = f"{package.__name__}.{old}"
+        module = sys.modules.setdefault(name, _stand_in(package.__name__, old, targets))
+        if not hasattr(package, old):
+            setattr(package, old, module)
