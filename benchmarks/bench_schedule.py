@@ -33,7 +33,7 @@ def main() -> None:
     jax.config.update("jax_num_cpu_devices", os.cpu_count() or 1)
 
     import jaxcelt as jc
-    from jaxcelt.studies.benchmarking import make_solver
+    from jaxcelt.integrate.solvers import make_solver
     from jaxcelt.sweeps.sweep import SweepConfig, lanes_params, run_lanes
     from jaxcelt.versions import versions
 

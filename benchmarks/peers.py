@@ -37,6 +37,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import _numba_model as nm  # noqa: E402
 
 import jaxcelt as jc  # noqa: E402
+from jaxcelt.integrate import solvers  # noqa: E402
 from jaxcelt.studies import benchmarking as bm  # noqa: E402
 from jaxcelt.versions import versions  # noqa: E402
 
@@ -105,7 +106,7 @@ def single(scene, ys_ref, rtols, targets, numpy_rhs: bool, quick: bool = False):
     fp = nm.python_rhs(scene.params)
     _numba_ens(scene, 1e-6)  # compile
     for m in ("DOP853", "Radau"):  # warm up the scipy paths (numba specialises on the call signature)
-        _scipy(bm.Scene(scene.name, scene.params, scene.y0, 0.01, np.array([0.0, 0.01]), ""), m, fn, 1e-4)
+        _scipy(bm.BenchmarkScene(scene.name, scene.params, scene.y0, 0.01, np.array([0.0, 0.01]), ""), m, fn, 1e-4)
     sim = scene.t1
 
     def add(name, ys, sec, nfev, ok, rtol, compile_s=None):
@@ -311,7 +312,7 @@ def main(argv=None):
         scene.y0,
         scene.t1,
         ts=scene.ts,
-        solver=bm.make_solver("Dopri8"),
+        solver=solvers.make_solver("Dopri8"),
         rtol=1e-13,
         atol=1e-13,
         exact_ts=True,

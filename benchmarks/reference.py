@@ -30,13 +30,14 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import jaxcelt as jc  # noqa: E402
+from jaxcelt.integrate import solvers  # noqa: E402
 from jaxcelt.studies import benchmarking as bm  # noqa: E402
 from jaxcelt.versions import versions  # noqa: E402
 
 TOL = 1e-13
 
 
-def scipy_dop853(scene: bm.Scene, tol: float = TOL, rhs: str = "numba"):
+def scipy_dop853(scene: bm.BenchmarkScene, tol: float = TOL, rhs: str = "numba"):
     """scipy DOP853 restarted on each sample interval; returns (ys, nfev, seconds, rhs_name)."""
     from scipy.integrate import solve_ivp
 
@@ -68,17 +69,17 @@ def scipy_dop853(scene: bm.Scene, tol: float = TOL, rhs: str = "numba"):
     return np.array(ys), nfev, time.perf_counter() - t0, name
 
 
-def diffrax_dopri8(scene: bm.Scene, tol: float = TOL):
+def diffrax_dopri8(scene: bm.BenchmarkScene, tol: float = TOL):
     t0 = time.perf_counter()
     sol = jc.simulate(
-        scene.params, scene.y0, scene.t1, ts=scene.ts, solver=bm.make_solver("Dopri8"),
+        scene.params, scene.y0, scene.t1, ts=scene.ts, solver=solvers.make_solver("Dopri8"),
         rtol=tol, atol=tol, exact_ts=True, max_steps=2_000_000,
     )  # fmt: skip
     ys = np.asarray(jax.block_until_ready(sol.ys))
     return ys, int(sol.num_steps), time.perf_counter() - t0, int(sol.status)
 
 
-def reference(scene: bm.Scene, *, tol: float = TOL, trust: float = 1e-8, rhs: str = "numba") -> dict:
+def reference(scene: bm.BenchmarkScene, *, tol: float = TOL, trust: float = 1e-8, rhs: str = "numba") -> dict:
     """Both references on one scene and their agreement per sample time."""
     ya, steps_a, sec_a, status_a = diffrax_dopri8(scene, tol)
     yb, nfev_b, sec_b, rhs_name = scipy_dop853(scene, tol, rhs)

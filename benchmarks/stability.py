@@ -44,7 +44,9 @@ import numpy as np
 import optimistix as optx
 
 import jaxcelt as jc
+from jaxcelt.integrate import solvers
 from jaxcelt.integrate.lyapunov import celt_lyapunov
+from jaxcelt.plotting import results
 from jaxcelt.studies import benchmarking as bm
 from jaxcelt.sweeps.regimes import classify, regime_names
 from jaxcelt.versions import versions
@@ -92,19 +94,19 @@ def _f(x):
 
 
 def make_solver(name, rtol, atol):
-    """`bm.make_solver` plus "Kvaerno5-chord": diffrax's VeryChord root finder with the
+    """`solvers.make_solver` plus "Kvaerno5-chord": diffrax's VeryChord root finder with the
     controller's tolerances given explicitly (`jaxcelt.simulate` replaces a *default* VeryChord
     by full Newton, so diffrax's default behaviour has to be requested explicitly)."""
     if name == "Kvaerno5-chord":
         return diffrax.Kvaerno5(root_finder=diffrax.VeryChord(rtol=rtol, atol=atol, norm=optx.rms_norm))
-    return bm.make_solver(name)
+    return solvers.make_solver(name)
 
 
 def solve(part, sc, name, *, rtol=1e-8, atol=None, dt0=None, max_steps=300_000, dtype=None, y0=None, **kw):
     """One solve; returns (sol, ys float64, run_s, compile_s). The first call of each compiled
     configuration is run twice to separate compile time from run time."""
     atol = rtol * 1e-2 if atol is None else atol
-    fixed = bm.SOLVERS.get(name, (None, "implicit"))[1] == "fixed"
+    fixed = solvers.SOLVERS.get(name, (None, "implicit"))[1] == "fixed"
     solver = make_solver(name, rtol, atol)
     y0 = sc.y0 if y0 is None else y0
 
@@ -114,7 +116,7 @@ def solve(part, sc, name, *, rtol=1e-8, atol=None, dt0=None, max_steps=300_000, 
             exact_ts=not fixed, dtype=dtype, max_steps=max_steps, **kw,
         )  # fmt: skip
 
-    implicit = bm.SOLVERS.get(name, (None, "implicit"))[1] == "implicit"
+    implicit = solvers.SOLVERS.get(name, (None, "implicit"))[1] == "implicit"
     key = (name, rtol if implicit else None, len(sc.ts), max_steps, str(dtype), fixed, tuple(kw.items()))
     t = time.perf_counter()
     sol = jax.block_until_ready(fn())
@@ -454,7 +456,7 @@ def part_d(part, args):
 def part_e(part, args):
     p = jc.CeltParams.paper(omega_pi=17.0)
     T = 2 * np.pi / 17
-    sc = bm.Scene("e", p, np.zeros(13), 0.5 * T, np.linspace(0.0, 0.5 * T, 11), "")
+    sc = bm.BenchmarkScene("e", p, np.zeros(13), 0.5 * T, np.linspace(0.0, 0.5 * T, 11), "")
     part.set(
         "setup", dict(solver="Tsit5 rtol 1e-8", horizon_s=0.5 * T, semi_axes_m=[float(p.a1), float(p.a2), float(p.a3)])
     )
@@ -463,7 +465,7 @@ def part_e(part, args):
         return int(sol.status) == 2
 
     def run(case, x, y0, stop=False, horizon=None):
-        s = sc if horizon is None else bm.Scene("e", p, np.zeros(13), horizon, np.linspace(0.0, horizon, 11), "")
+        s = sc if horizon is None else bm.BenchmarkScene("e", p, np.zeros(13), horizon, np.linspace(0.0, horizon, 11), "")
         sol, ys, run_s, _ = solve(part, s, "Tsit5", rtol=1e-8, y0=y0, max_steps=20_000, stop_on_invalid=stop)
         # after a stop_on_invalid stop diffrax fills the later samples with inf: not a NaN
         finite = (
@@ -536,7 +538,7 @@ def plot_all(out, slow):
         plot_verdict_grid,
     )
 
-    cells = bm.stability_results(out).get("a", [])
+    cells = results.stability_results(out).get("a", [])
     if cells:
         title = "(a) friction-smoothing stiffness: stick-slip scene (omega_pi 17, q_pi 0.01 m), 1 period"
         plot_verdict_grid(cells, title, slow=slow).savefig(out / "stability_eps.png", dpi=110)

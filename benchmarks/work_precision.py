@@ -32,6 +32,7 @@ import numpy as np
 import optimistix as optx
 
 import jaxcelt as jc
+from jaxcelt.integrate import solvers
 from jaxcelt.studies import benchmarking as bm
 from jaxcelt.versions import versions
 
@@ -42,18 +43,18 @@ FIXED = ["RK4-fixed", "Heun-fixed"]
 
 def _stages_per_step(name: str) -> int:
     """RHS evaluations per step (accepted or rejected) of an explicit / fixed-step method."""
-    s = bm.make_solver(name)
+    s = solvers.make_solver(name)
     s = getattr(s, "solver", s)
     tab = getattr(s, "tableau", None)
     if tab is None:
         return 1  # Euler
-    return tab.num_stages - (1 if tab.fsal and bm.SOLVERS[name][1] != "fixed" else 0)
+    return tab.num_stages - (1 if tab.fsal and solvers.SOLVERS[name][1] != "fixed" else 0)
 
 
-def reference_ys(scene: bm.Scene, law=None) -> tuple[np.ndarray, dict]:
+def reference_ys(scene: bm.BenchmarkScene, law=None) -> tuple[np.ndarray, dict]:
     t = time.perf_counter()
     sol = jc.simulate(
-        scene.params, scene.y0, scene.t1, ts=scene.ts, solver=bm.make_solver("Dopri8"), rtol=1e-13, atol=1e-13,
+        scene.params, scene.y0, scene.t1, ts=scene.ts, solver=solvers.make_solver("Dopri8"), rtol=1e-13, atol=1e-13,
         exact_ts=True, contact_law=law, max_steps=2_000_000,
     )  # fmt: skip
     ys = np.asarray(jax.block_until_ready(sol.ys))
@@ -66,7 +67,7 @@ def _register_chord(rtol: float, atol: float) -> None:
     every stage and iteration) with the tolerances diffeqsolve would give it (the controller's
     rtol/atol, RMS norm). Given explicitly, because `jaxcelt.simulate` replaces the *default*
     VeryChord by full Newton since commit ed5e6fc; an explicit root finder is kept as it is."""
-    bm.SOLVERS["Kvaerno5-chord"] = (
+    solvers.SOLVERS["Kvaerno5-chord"] = (
         lambda: diffrax.Kvaerno5(root_finder=diffrax.VeryChord(rtol=rtol, atol=atol, norm=optx.rms_norm)),
         "implicit",
     )
@@ -81,7 +82,7 @@ def ladder(scene, name, values, *, ys_ref, law=None, dtype=None, max_run_s=10.0,
     out = []
     if name == "Kvaerno5-chord":
         _register_chord(values[0], values[0] * 1e-2)
-    kind = bm.SOLVERS[name][1]
+    kind = solvers.SOLVERS[name][1]
     t_ladder = time.perf_counter()
     count = kind == "implicit"
     for v in values:

@@ -42,7 +42,7 @@ MOVED: Mapping[str, tuple[str, ...]] = MappingProxyType(
         "data": ("jaxcelt.identify.records",),
         "fit": ("jaxcelt.identify.fit",),
         "ladder": ("jaxcelt.studies.ladder",),
-        "benchmarking": ("jaxcelt.studies.benchmarking",),
+        "benchmarking": ("jaxcelt.studies.benchmarking", "jaxcelt.integrate.solvers", "jaxcelt.plotting.results"),
     }
 )
 """Old module name -> the modules that now hold its names (searched in order)."""

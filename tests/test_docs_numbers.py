@@ -420,7 +420,7 @@ def test_repository_url_is_declared_once_and_used_by_the_notebooks():
 
 def test_notebook_results_are_shipped_with_the_package():
     # every result file notebook 05 reads (jaxcelt.studies.benchmarking.RESULT_FILES) is committed and force-included
-    from jaxcelt.studies.benchmarking import RESULT_FILES
+    from jaxcelt.plotting.results import RESULT_FILES
 
     forced = tomllib.loads(_text("pyproject.toml"))["tool"]["hatch"]["build"]["targets"]["wheel"]["force-include"]
     for name in RESULT_FILES:

@@ -297,7 +297,7 @@ def run(args) -> int:
 
     import jaxcelt as jc
     from jaxcelt.commands._warnings import one_line_warnings
-    from jaxcelt.studies.benchmarking import make_solver
+    from jaxcelt.integrate.solvers import make_solver
     from jaxcelt.sweeps.dataset import open_sweep
     from jaxcelt.sweeps.sweep import sweep
     from jaxcelt.versions import versions_string

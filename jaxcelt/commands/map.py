@@ -117,7 +117,7 @@ def run(args) -> int:
 
     import jaxcelt as jc
     from jaxcelt.commands._warnings import one_line_warnings
-    from jaxcelt.studies.benchmarking import make_solver
+    from jaxcelt.integrate.solvers import make_solver
     from jaxcelt.versions import versions_string
 
     # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2), before any work

@@ -4,16 +4,15 @@ The building blocks of ``benchmarks/{reference,work_precision,stability,peers}.p
 ``notebooks/05_speed_accuracy.ipynb``. Nothing here is physics: every trajectory comes
 from `jaxcelt.simulate` (or from a peer integrator calling the same right-hand side).
 
-* `Scene` / `make_scene`: named test problems (from rest at omega_pi = 14, 17, 19; a fixed-table
+* `BenchmarkScene` / `make_scene`: named test problems (from rest at omega_pi = 14, 17, 19; a fixed-table
   spin reversal; a stick-slip scene with small eps) with their stroboscopic sample times.
 * `state_error`: the accuracy measure of every chart -- the largest absolute state error (SI
   units) over the sample times and the 13 state components.
 * `time_call`: compile time and best-of-n run time of a JAX call, apart (``block_until_ready``).
 * `run_diffrax`: one solver at one tolerance (or fixed step) on one scene: time, steps, RHS
   evaluations, status, error.
-* `RK4`, `FixedStep`: the classical 4th-order Runge-Kutta method for diffrax (diffrax ships none)
-  and a wrapper that makes any diffrax Runge-Kutta method take constant steps (diffrax's Heun,
-  Ralston and Midpoint carry an error estimate, so `simulate` would otherwise step adaptively).
+* solvers are named as in `jaxcelt.integrate.solvers.SOLVERS` (``make_solver``); committed results are read back
+  by `jaxcelt.plotting.results`.
 * `count_rhs_evals`: number of right-hand-side calls of a solve via a counting contact law. For
   implicit solvers this does *not* include the forward-mode Jacobian's columns (jax.jacfwd
   evaluates them as one batched call, which the host-side counter sees once), so it understates
@@ -25,34 +24,28 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Callable
-from typing import Any, ClassVar
+from typing import Any
 
-import diffrax
 import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
-import optimistix as optx
 
 from jaxcelt import _config  # noqa: F401
-from jaxcelt._diffrax_adapter import use_stepsize_tol
 from jaxcelt.integrate.solve import simulate
+from jaxcelt.integrate.solvers import SOLVERS, make_solver
 from jaxcelt.physics.contact.laws import AbstractContactLaw
 from jaxcelt.physics.contact.registry import get_contact_law
 from jaxcelt.physics.params import CeltParams
 from jaxcelt.physics.state import initial_state
 
 __all__ = [
-    "Scene",
+    "BenchmarkScene",
     "SCENES",
     "make_scene",
     "state_error",
     "time_call",
     "run_diffrax",
-    "RK4",
-    "FixedStep",
-    "SOLVERS",
-    "make_solver",
     "count_rhs_evals",
     "CountingLaw",
     "device_string",
@@ -64,7 +57,7 @@ __all__ = [
 
 
 @dataclasses.dataclass(frozen=True)
-class Scene:
+class BenchmarkScene:
     """A test problem: parameters, initial state, horizon and the sample times of the error."""
 
     name: str
@@ -82,7 +75,7 @@ class Scene:
 SCENES = ("rest14", "rest17", "rest19", "spin_reversal", "stick_slip")
 
 
-def make_scene(name: str, periods: int = 5, **overrides) -> Scene:
+def make_scene(name: str, periods: int = 5, **overrides) -> BenchmarkScene:
     """A named test scene.
 
     * ``rest14|rest17|rest19``: the stone at rest on the base, n = e3, psi = 0, driven at
@@ -118,7 +111,7 @@ def make_scene(name: str, periods: int = 5, **overrides) -> Scene:
         desc = f"stick-slip, q_pi = {float(p.q_pi):g} m, eps = {float(p.eps):g}, {periods} period(s), T/5 samples"
     else:
         raise ValueError(f"unknown scene {name!r}; known: {SCENES}")
-    return Scene(name=name, params=p, y0=np.asarray(y0), t1=float(ts[-1]), ts=ts, description=desc)
+    return BenchmarkScene(name=name, params=p, y0=np.asarray(y0), t1=float(ts[-1]), ts=ts, description=desc)
 
 
 def state_error(ys: Any, ys_ref: Any) -> float:
@@ -132,98 +125,10 @@ def state_error(ys: Any, ys_ref: Any) -> float:
     return float(np.max(np.abs(a - b)))
 
 
-# --------------------------------------------------------------------------------------------
-# solvers
-
-
-_rk4_tableau = diffrax.ButcherTableau(
-    a_lower=(np.array([0.5]), np.array([0.0, 0.5]), np.array([0.0, 0.0, 1.0])),
-    b_sol=np.array([1 / 6, 1 / 3, 1 / 3, 1 / 6]),
-    # embedded error: difference to the 2nd-order midpoint method (unused with constant steps)
-    b_error=np.array([1 / 6, 1 / 3 - 1, 1 / 3, 1 / 6]),
-    c=np.array([0.5, 0.5, 1.0]),
-)
-
-
-class RK4(diffrax.AbstractERK):
-    """The classical 4th-order Runge-Kutta method (4 stages), for use with constant steps."""
-
-    tableau: ClassVar[diffrax.ButcherTableau] = _rk4_tableau
-    interpolation_cls: ClassVar[Callable[..., Any]] = diffrax.ThirdOrderHermitePolynomialInterpolation.from_k
-
-    def order(self, terms):
-        return 4
-
-
-class FixedStep(diffrax.AbstractSolver):
-    """Runs a diffrax solver with constant steps in `jaxcelt.simulate`.
-
-    Deliberately *not* an ``AbstractWrappedSolver`` (those forward ``isinstance`` checks), so
-    `simulate` sees a solver without error estimate and uses ``ConstantStepSize``.
-    """
-
-    solver: diffrax.AbstractSolver
-
-    @property
-    def term_structure(self):
-        return self.solver.term_structure
-
-    @property
-    def interpolation_cls(self):  # pyright: ignore
-        return self.solver.interpolation_cls
-
-    def order(self, terms):
-        return self.solver.order(terms)
-
-    def init(self, terms, t0, t1, y0, args):
-        return self.solver.init(terms, t0, t1, y0, args)
-
-    def step(self, terms, t0, t1, y0, args, solver_state, made_jump):
-        y1, _, dense, state, result = self.solver.step(terms, t0, t1, y0, args, solver_state, made_jump)
-        return y1, None, dense, state, result
-
-    def func(self, terms, t0, y0, args):
-        return self.solver.func(terms, t0, y0, args)
-
-
-def _newton():
-    return optx.Newton(rtol=use_stepsize_tol, atol=use_stepsize_tol, norm=optx.rms_norm)
-
-
-SOLVERS: dict[str, tuple[Callable[[], diffrax.AbstractSolver], str]] = {
-    "Tsit5": (diffrax.Tsit5, "explicit"),
-    "Dopri5": (diffrax.Dopri5, "explicit"),
-    "Dopri8": (diffrax.Dopri8, "explicit"),
-    "Kvaerno3": (diffrax.Kvaerno3, "implicit"),
-    "Kvaerno5": (diffrax.Kvaerno5, "implicit"),
-    "Kvaerno3-Newton": (lambda: diffrax.Kvaerno3(root_finder=_newton()), "implicit"),
-    "Kvaerno5-Newton": (lambda: diffrax.Kvaerno5(root_finder=_newton()), "implicit"),
-    "RK4-fixed": (lambda: FixedStep(RK4()), "fixed"),
-    "Heun-fixed": (lambda: FixedStep(diffrax.Heun()), "fixed"),
-    "Midpoint-fixed": (lambda: FixedStep(diffrax.Midpoint()), "fixed"),
-    "Euler-fixed": (diffrax.Euler, "fixed"),
-}
-"""name -> (factory, kind) with kind in explicit | implicit | fixed."""
-
-
-def make_solver(name: str) -> diffrax.AbstractSolver:
-    """A fresh solver by `SOLVERS` name.
-
-    ``*-Newton`` variants replace diffrax's default root finder (`diffrax.VeryChord`: one
-    Jacobian per step, reused by every stage and iteration) by full Newton (`optimistix.Newton`,
-    a fresh Jacobian per iteration); tolerances are the step controller's in both cases.
-    KenCarp3/4/5 are IMEX methods that need a ``MultiTerm(explicit, implicit)``, which
-    `jaxcelt.simulate` does not build (the wobblestone field has no natural split), so they are
-    not in the table.
-    """
-    if name not in SOLVERS:
-        raise ValueError(f"unknown solver {name!r}; known: {sorted(SOLVERS)}")
-    return SOLVERS[name][0]()
-
-
 def device_string() -> str:
     d = jax.devices()[0]
     return f"{jax.default_backend()}: {d.device_kind} (x{jax.device_count()})"
+
 
 
 # --------------------------------------------------------------------------------------------
@@ -283,7 +188,7 @@ class CountingLaw(AbstractContactLaw):
         return self.inner.loads(kin, e_x, e_y, n, p)
 
 
-def count_rhs_evals(scene: Scene, solver, *, rtol=1e-8, atol=1e-10, dt0=None, law=None, dtype=None, max_steps=200_000):
+def count_rhs_evals(scene: BenchmarkScene, solver, *, rtol=1e-8, atol=1e-10, dt0=None, law=None, dtype=None, max_steps=200_000):
     """Right-hand-side calls of one solve (for implicit solvers: Jacobian columns not included --
     a batched jacfwd call is seen once; see the module docstring).
 
@@ -303,7 +208,7 @@ def count_rhs_evals(scene: Scene, solver, *, rtol=1e-8, atol=1e-10, dt0=None, la
 
 
 def run_diffrax(
-    scene: Scene,
+    scene: BenchmarkScene,
     solver_name: str,
     *,
     rtol: float = 1e-8,
@@ -358,147 +263,3 @@ def run_diffrax(
             scene, solver, rtol=rtol, atol=atol, dt0=dt0, law=law, dtype=dtype, max_steps=max_steps
         )
     return out
-
-
-# --------------------------------------------------------------------------------------------
-# reading results back (docs and notebook)
-
-
-_A_ORDER = [
-    "Tsit5 rtol 1e-06",
-    "Tsit5 rtol 1e-08",
-    "Dopri8 rtol 1e-06",
-    "Kvaerno5-chord rtol 1e-06",
-    "Kvaerno5-Newton rtol 1e-06",
-    "Kvaerno5-Newton rtol 1e-08",
-]
-
-
-def stability_results(folder: str = "docs/performance") -> dict[str, list[dict]]:
-    """Rows of the stability study (``benchmarks/stability.py``), one list per part a-e.
-
-    Part (a) merges ``stability_a.json`` with the re-runs: a (method, eps) cell is replaced by
-    the one in ``stability_a_implicit.json`` (implicit re-run with a larger budget) where that
-    file has it, then -- only where the cell was unverified or not run -- by
-    ``stability_a_eps1e-10.json`` (eps = 1e-10 with a 3e6-step budget, which lets the reference
-    finish; explicit cells keep their 3e5-step verdict so the map has one budget).
-    """
-    import json
-    import pathlib
-
-    out: dict[str, list[dict]] = {}
-    folder = pathlib.Path(folder)
-    cells: list[dict] = []
-    for tag in ("a", "a_implicit", "a_eps1e-10"):
-        f = folder / f"stability_{tag}.json"
-        if not f.exists():
-            continue
-        for r in json.loads(f.read_text())["rows"]:
-            if r.get("kind") != "cell":
-                continue
-            old = [c for c in cells if c["method"] == r["method"] and c["eps"] == r["eps"]]
-            if tag == "a_eps1e-10" and old and old[0]["verdict"] not in ("unverified", "not run"):
-                continue
-            cells = [c for c in cells if c not in old] + [r]
-    if cells:
-        key = lambda r: (_A_ORDER.index(r["method"]) if r["method"] in _A_ORDER else 99, -r["eps"])  # noqa: E731
-        out["a"] = sorted(cells, key=key)
-    for part in ("b", "c", "d", "e"):
-        f = folder / f"stability_{part}.json"
-        if f.exists():
-            out[part] = json.loads(f.read_text())["rows"]
-    return out
-
-
-# The committed result files of the speed/accuracy study that notebooks read (shipped in the wheel
-# under jaxcelt/_results/performance, see [tool.hatch.build.targets.wheel.force-include]).
-RESULT_FILES: tuple[str, ...] = (
-    "reference.json",
-    "work_precision.json",
-    "peers.json",
-    "peers_idle.json",
-    "stability_a.json",
-    "stability_a_implicit.json",
-    "stability_a_eps1e-10.json",
-    "stability_b.json",
-    "stability_c.json",
-    "stability_d.json",
-    "stability_e.json",
-)
-
-
-def results_dir(kind: str = "performance") -> Any:
-    """The folder holding committed results of one kind: ``"performance"`` (the speed/accuracy
-    results, `RESULT_FILES`) or ``"orbits"`` (periodic-orbit branches, census, bifurcation points).
-
-    An installed wheel has them as package data (``jaxcelt/_results/<kind>``); a checkout
-    (editable install) reads ``docs/<kind>`` of the repository. Raises ``FileNotFoundError``
-    when neither holds them, rather than letting a notebook show nothing."""
-    import pathlib
-    from importlib import resources
-
-    marker = {"performance": "reference.json", "orbits": "branches.json"}
-    if kind not in marker:
-        raise ValueError(f"kind must be one of {sorted(marker)}, got {kind!r}")
-    candidates = [
-        pathlib.Path(str(resources.files("jaxcelt") / "_results" / kind)),
-        pathlib.Path(__file__).resolve().parents[1] / "docs" / kind,
-    ]
-    for c in candidates:
-        if (c / marker[kind]).is_file():
-            return c
-    raise FileNotFoundError(
-        f"the committed {kind} results ({marker[kind]}, ...) were found in neither "
-        + " nor ".join(str(c) for c in candidates)
-        + '; install jaxcelt from the repository (pip install "jaxcelt @ git+https://github.com/jaxcelt/jaxcelt")'
-    )
-
-
-def load_results(folder: Any = None, quick: bool = False) -> dict[str, Any]:
-    """The JSON files written by ``benchmarks/*.py`` (missing ones are left out); the stability
-    study's per-part files come back as ``["stability"]`` = `stability_results` (full size only).
-    ``folder`` defaults to `results_dir` (the committed results)."""
-    import json
-    import pathlib
-
-    if folder is None:
-        folder = results_dir()
-    tag = "_quick" if quick else ""
-    out = {}
-    for name in ("reference", "work_precision", "peers", "peers_idle"):
-        f = pathlib.Path(folder) / f"{name}{tag}.json"
-        if f.exists():
-            out[name] = json.loads(f.read_text())
-    if not quick:
-        st = stability_results(folder)
-        if st:
-            out["stability"] = st
-    return out
-
-
-def markdown_table(rows: list[dict], columns: list[str], fmt: dict[str, str] | None = None) -> str:
-    """A Markdown table of ``rows`` (dicts) restricted to ``columns``; floats via ``fmt``."""
-    fmt = fmt or {}
-
-    def cell(r, c):
-        v = r.get(c)
-        if v is None:
-            return ""
-        if isinstance(v, float):
-            return format(v, fmt.get(c, ".3g"))
-        return str(v)
-
-    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
-    lines += ["| " + " | ".join(cell(r, c) for c in columns) + " |" for r in rows]
-    return "\n".join(lines)
-
-
-def cheapest_at_accuracy(runs: list[dict], target: float) -> list[dict]:
-    """Per solver, the fastest run whose error is <= ``target`` (work-precision at equal accuracy)."""
-    best: dict[str, dict] = {}
-    for r in runs:
-        err = r.get("error")
-        if r.get("status", 0) == 0 and err is not None and np.isfinite(err) and err <= target:
-            if r["solver"] not in best or r["run_s"] < best[r["solver"]]["run_s"]:
-                best[r["solver"]] = r
-    return sorted(best.values(), key=lambda r: r["run_s"])
