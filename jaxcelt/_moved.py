@@ -14,7 +14,7 @@ import warnings
 from collections.abc import Mapping
 from types import MappingProxyType
 
-__all__ = ["MOVED", "install"]
+__all__ = ["MOVED", "RENAMED", "install"]
 
 MOVED: Mapping[str, tuple[str, ...]] = MappingProxyType(
     {
@@ -47,6 +47,14 @@ MOVED: Mapping[str, tuple[str, ...]] = MappingProxyType(
 )
 """Old module name -> the modules that now hold its names (searched in order)."""
 
+RENAMED: Mapping[str, Mapping[str, str]] = MappingProxyType(
+    {
+        "ladder": MappingProxyType({"OBSERVABLES": "jaxcelt.studies.ladder:QUANTITIES"}),
+        "benchmarking": MappingProxyType({"Scene": "jaxcelt.studies.benchmarking:BenchmarkScene"}),
+    }
+)
+"""Old module name -> {old name: "new.module:new_name"} for names that were renamed as they moved."""
+
 
 def _stand_in(package: str, old: str, targets: tuple[str, ...]) -> types.ModuleType:
     name = f"{package}.{old}"
@@ -55,16 +63,19 @@ def _stand_in(package: str, old: str, targets: tuple[str, ...]) -> types.ModuleT
     def __getattr__(attr: str):
         if attr.startswith("__"):
             raise AttributeError(attr)
-        for target in targets:
+        renamed = RENAMED.get(old, {}).get(attr)
+        found = [(renamed.partition(":")[0], renamed.partition(":")[2])] if renamed else []
+        found += [(t, attr) for t in targets if not renamed]
+        for target, new_attr in found:
             mod = importlib.import_module(target)
-            if hasattr(mod, attr):
+            if hasattr(mod, new_attr):
+                public = " (or jaxcelt." + new_attr + ")" if new_attr in getattr(sys.modules[package], "__all__", ()) else ""
                 warnings.warn(
-                    f"{name} is deprecated and will be removed in the next release; "
-                    f"use {mod.__name__}.{attr} (or jaxcelt.{attr} where it is public)",
+                    f"{name} is deprecated and will be removed in the next release; use {target}.{new_attr}{public}",
                     DeprecationWarning,
                     stacklevel=2,
                 )
-                return getattr(mod, attr)
+                return getattr(mod, new_attr)
         raise AttributeError(f"module {name!r} has no attribute {attr!r} (it moved to {', '.join(targets)})")
 
     module.__getattr__ = __getattr__  # type: ignore[method-assign]

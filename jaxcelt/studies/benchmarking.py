@@ -22,6 +22,7 @@ from `jaxcelt.simulate` (or from a peer integrator calling the same right-hand s
 from __future__ import annotations
 
 import dataclasses
+import threading
 import time
 from collections.abc import Callable
 from typing import Any
@@ -160,7 +161,11 @@ class _Counter:
         self.n = 0
 
 
+# A cache of one object, kept on purpose: the counter is a static field of `CountingLaw`, so one process-wide counter
+# lets the counting solve compile once per solver. `count_rhs_evals` holds the lock while it resets and reads it,
+# so counts from two threads never mix.
 _COUNTER = _Counter()
+_COUNTER_LOCK = threading.Lock()
 
 
 class CountingLaw(AbstractContactLaw):
@@ -195,16 +200,17 @@ def count_rhs_evals(scene: BenchmarkScene, solver, *, rtol=1e-8, atol=1e-10, dt0
     Counts contact-law calls and subtracts the validity monitor's one per step (+1 at init).
     """
     inner = get_contact_law(law)
-    counter = _COUNTER  # one static object: the counting solve compiles once per solver
-    counter.n = 0
-    cl = CountingLaw(inner=inner, counter=counter, rolling_resistance=inner.rolling_resistance)
-    sol = simulate(
-        scene.params, scene.y0, scene.t1, ts=scene.ts, solver=solver, rtol=rtol, atol=atol, dt0=dt0,
-        contact_law=cl, exact_ts=dt0 is None, dtype=dtype, max_steps=max_steps,
-    )  # fmt: skip
-    jax.block_until_ready(sol.ys)
-    jax.effects_barrier()
-    return int(counter.n - int(sol.num_steps) - 1)
+    with _COUNTER_LOCK:
+        counter = _COUNTER
+        counter.n = 0
+        cl = CountingLaw(inner=inner, counter=counter, rolling_resistance=inner.rolling_resistance)
+        sol = simulate(
+            scene.params, scene.y0, scene.t1, ts=scene.ts, solver=solver, rtol=rtol, atol=atol, dt0=dt0,
+            contact_law=cl, exact_ts=dt0 is None, dtype=dtype, max_steps=max_steps,
+        )  # fmt: skip
+        jax.block_until_ready(sol.ys)
+        jax.effects_barrier()
+        return int(counter.n - int(sol.num_steps) - 1)
 
 
 def run_diffrax(

@@ -40,7 +40,7 @@ __all__ = [
     "Scene",
     "Rung",
     "RungResult",
-    "OBSERVABLES",
+    "QUANTITIES",
     "HERTZ_CALIBRATED",
     "default_ladder",
     "builtin_scenes",
@@ -65,7 +65,7 @@ def hertz_params(p: CeltParams) -> CeltParams:
     return p.replace(**HERTZ_S_PARAMS)
 
 
-OBSERVABLES: dict[str, tuple[Callable, tuple[int, ...]]] = {
+QUANTITIES: dict[str, tuple[Callable, tuple[int, ...]]] = {
     "omega": (lambda ts, ys, p: ys[:, 3:6], (3, 4, 5)),
     "omega3": (lambda ts, ys, p: ys[:, 5], (5,)),
     "spin": (lambda ts, ys, p: jnp.sum(ys[:, 3:6] * ys[:, 6:9], axis=1), (3, 4, 5, 6, 7, 8)),
@@ -74,7 +74,8 @@ OBSERVABLES: dict[str, tuple[Callable, tuple[int, ...]]] = {
     "energy": (lambda ts, ys, p: jax.vmap(energy, in_axes=(0, None))(ys, p), tuple(range(9))),
     "r_O": (lambda ts, ys, p: jax.vmap(centre_position, in_axes=(0, None))(ys, p)[:, :2], tuple(range(6, 13))),
 }
-"""name -> (function (ts, ys, params) -> values over time, state components it reads)."""
+"""The quantities a scene compares between rungs: name -> (function (ts, ys, params) -> values over time, state
+components it reads). (Not the sensor observables of identification, `jaxcelt.identify.observe.OBSERVABLES`.)"""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -82,7 +83,7 @@ class Scene:
     """What a user wants to simulate and look at.
 
     ``params`` (with S_i as the pressure profile's), ``y0`` (13,), ``forcing`` (overrides of
-    q_pi, omega_pi applied to params), ``t1`` horizon [s], ``observed`` names in `OBSERVABLES`,
+    q_pi, omega_pi applied to params), ``t1`` horizon [s], ``observed`` names in `QUANTITIES`,
     ``n_save`` saved samples.
     """
 
@@ -96,9 +97,9 @@ class Scene:
     description: str = ""
 
     def __post_init__(self):
-        unknown = set(self.observed) - set(OBSERVABLES)
+        unknown = set(self.observed) - set(QUANTITIES)
         if unknown:
-            raise ValueError(f"Scene {self.name!r}: unknown observed {sorted(unknown)}; known {sorted(OBSERVABLES)}")
+            raise ValueError(f"Scene {self.name!r}: unknown observed {sorted(unknown)}; known {sorted(QUANTITIES)}")
         if not self.t1 > 0:
             raise ValueError(f"Scene {self.name!r}: t1 must be > 0, got {self.t1}")
 
@@ -172,7 +173,7 @@ def _simulate(scene: Scene, rung: Rung, rtol: float, atol: float):
 
 
 def _observe(scene: Scene, ts, ys, p) -> dict:
-    return {k: np.asarray(OBSERVABLES[k][0](ts, ys, p)) for k in scene.observed}
+    return {k: np.asarray(QUANTITIES[k][0](ts, ys, p)) for k in scene.observed}
 
 
 def run_ladder(
@@ -242,7 +243,7 @@ def needed_state(scene: Scene, law: AbstractContactLaw | str | None = None, n_po
     dep = np.any(np.abs(np.asarray(J)) > 0, axis=0)  # dep[i, j]: y_i' depends on y_j
     needed = set()
     for k in scene.observed:
-        needed |= set(OBSERVABLES[k][1])
+        needed |= set(QUANTITIES[k][1])
     while True:
         new = needed | {j for i in needed for j in np.nonzero(dep[i])[0]}
         if new == needed:
@@ -252,7 +253,7 @@ def needed_state(scene: Scene, law: AbstractContactLaw | str | None = None, n_po
     return {
         "needed": names,
         "droppable": [n for i, n in enumerate(STATE_NAMES) if i not in needed],
-        "reads": {k: [STATE_NAMES[i] for i in OBSERVABLES[k][1]] for k in scene.observed},
+        "reads": {k: [STATE_NAMES[i] for i in QUANTITIES[k][1]] for k in scene.observed},
     }
 
 
