@@ -2,7 +2,7 @@
 against a brute-force orbit diagram (scipy) -> docs/orbits/duffing_cascade.json and duffing_cascade.png.
 
 x'' + 0.3 x' - x + x^3 = F cos(1.2 t), right-well orbits, F from 0.24 to 0.293. The period-1 branch is
-continued in F (`continue_pseudo_arclength`); at each period doubling the period-2k branch is started
+continued in F (`continue_arclength`); at each period doubling the period-2k branch is started
 by `switch_at_period_doubling` and continued in turn, up to period 8. Independently, scipy DOP853
 integrates the oscillator over a grid of F (1000 transient periods, 64 section points, all F as one
 vectorised system) and finds each orbit's period (1e-6). At each doubling found by continuation the
@@ -25,7 +25,8 @@ import jax.numpy as jnp
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from jaxcelt.orbits.branch import continue_pseudo_arclength, switch_at_period_doubling
+from jaxcelt.orbits.branch import continue_arclength
+from jaxcelt.orbits.switching import switch_at_period_doubling
 from jaxcelt.versions import versions
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -90,7 +91,7 @@ def cascade(levels=3):
     out, branches = [], []
     for _ in range(levels):
         t = time.perf_counter()
-        br = continue_pseudo_arclength(duffing, y, args_of, period_of, lam, F1, k=k, ds=0.005, ds_max=0.02)
+        br = continue_arclength(duffing, y, args_of, period_of, lam, F1, k=k, ds=0.005, ds_max=0.02)
         pd = [b for b in br.bifurcations if b.kind == "period-doubling"]
         branches.append({"k": k, "F": br.values.tolist(), "x": br.y[:, 0].tolist(), "stable": br.stable.tolist()})
         if not pd:

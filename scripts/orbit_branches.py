@@ -27,7 +27,8 @@ import jax
 import numpy as np
 
 import jaxcelt as jc
-from jaxcelt.orbits.branch import ArclengthBranch, Bifurcation, branch_to_dict
+from jaxcelt.orbits.branch import ArclengthBranch, branch_to_dict
+from jaxcelt.orbits.points import Bifurcation
 from jaxcelt.physics.model import STATE_NAMES
 from jaxcelt.versions import versions
 
@@ -177,7 +178,7 @@ def main(argv=None) -> int:
             seen.append(np.asarray(orb.y))
             rows.append(
                 {
-                    "status": jc.celt_orbit.ORBIT_STATUS[int(orb.status)],
+                    "status": jc.orbits.ORBIT_STATUS[int(orb.status)],
                     "stable": bool(orb.stable),
                     "multipliers_abs": [float(x) for x in np.abs(np.asarray(orb.multipliers))],
                     "omega2": float(orb.y[4]),

@@ -1,4 +1,4 @@
-"""Pseudo-arclength continuation passes folds (`jaxcelt.orbits.branch.continue_pseudo_arclength`).
+"""Pseudo-arclength continuation passes folds (`jaxcelt.orbits.branch.continue_arclength`).
 
 Hardening Duffing x'' + 0.2 x' + x + x^3 = 0.3 cos(w t), period-1 frequency response continued
 in w from 0.8 to 2.5: the resonance curve bends right, so the branch turns back once (upper
@@ -18,7 +18,7 @@ import jax.numpy as jnp
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from jaxcelt.orbits.branch import continue_pseudo_arclength
+from jaxcelt.orbits.branch import continue_arclength
 
 C, F = 0.2, 0.3
 
@@ -46,7 +46,7 @@ def chart(y, ref, a):
 
 
 def test_arclength_passes_both_folds_of_hardening_duffing():
-    br = continue_pseudo_arclength(
+    br = continue_arclength(
         duffing,
         jnp.array([0.5, 0.0]),
         lambda w: jnp.stack([C, F, w]),

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from jaxcelt.orbits.branch import continue_periodic_orbit
+from jaxcelt.orbits.branch import continue_natural
 
 W = 1.2
 T = 2 * np.pi / W
@@ -37,7 +37,7 @@ def sections(F, y0, periods=800, last=4):
 @pytest.mark.slow
 def test_duffing_period_doubling_located_by_continuation_matches_brute_force():
     y0 = sections(0.24, [1.0, 0.0], periods=100, last=0)[-1]
-    br = continue_periodic_orbit(
+    br = continue_natural(
         oscillator,
         y0,
         lambda F: jnp.asarray(BASE).at[4].set(F),

@@ -1,4 +1,4 @@
-"""Figures and JSON of orbit branches (`jaxcelt.plotting.orbits`, `orbit_continuation.branch_to_dict`).
+"""Figures and JSON of orbit branches (`jaxcelt.plotting.orbits`, `jaxcelt.orbits.branch.branch_to_dict`).
 
 A constructed branch with a known stability pattern (stable, unstable, stable: two changes)
 and two marked points: the figure must draw three segments, solid-dashed-solid, mark both points
@@ -13,7 +13,8 @@ matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
 
-from jaxcelt.orbits.branch import ArclengthBranch, Bifurcation, branch_to_dict  # noqa: E402
+from jaxcelt.orbits.branch import ArclengthBranch, branch_to_dict  # noqa: E402
+from jaxcelt.orbits.points import Bifurcation  # noqa: E402
 from jaxcelt.physics.model import STATE_NAMES  # noqa: E402
 from jaxcelt.plotting.orbits import branch_figure, multipliers_figure  # noqa: E402
 

@@ -18,7 +18,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from jaxcelt.orbits.branch import continue_pseudo_arclength, switch_at_period_doubling
+from jaxcelt.orbits.branch import continue_arclength
+from jaxcelt.orbits.switching import switch_at_period_doubling
 
 W, D = 1.2, 0.3
 T = 2 * np.pi / W
@@ -42,7 +43,7 @@ def test_period_doubling_located_and_switched_matches_brute_force():
     args_of = lambda F: jnp.stack([D, F])  # noqa: E731
     period_of = lambda a: 2 * jnp.pi / W  # noqa: E731
     y0 = sections(0.24, [1.0, 0.0], 100, last=0)[-1]
-    br = continue_pseudo_arclength(duffing, y0, args_of, period_of, 0.24, 0.30, ds=0.01, ds_max=0.05)
+    br = continue_arclength(duffing, y0, args_of, period_of, 0.24, 0.30, ds=0.01, ds_max=0.05)
     assert br.stopped == "end value reached"
     pd = [b for b in br.bifurcations if b.kind == "period-doubling"]
     assert len(pd) == 1 and not [b for b in br.bifurcations if b.kind == "fold"]

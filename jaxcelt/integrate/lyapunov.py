@@ -37,7 +37,6 @@ from collections.abc import Callable
 from typing import Any, NamedTuple
 
 import diffrax
-import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -47,7 +46,7 @@ from jaxcelt._diffrax_adapter import solve_to
 from jaxcelt._types import Array, Scalar
 from jaxcelt.physics.contact.laws import AbstractContactLaw
 from jaxcelt.physics.contact.registry import get_contact_law
-from jaxcelt.physics.model import contact_geometry, vector_field
+from jaxcelt.physics.model import CeltField, contact_geometry
 from jaxcelt.physics.params import CeltParams
 
 __all__ = [
@@ -234,13 +233,6 @@ def celt_tangent_projection(y: Array, dy: Array, params: CeltParams) -> Array:
     return dy.at[0:3].add(-dc * n)
 
 
-class _CeltField(eqx.Module):
-    law: AbstractContactLaw
-
-    def __call__(self, t, y, args):
-        return vector_field(t, y, args, self.law)
-
-
 def celt_lyapunov(
     params: CeltParams,
     y0: Array,
@@ -263,7 +255,7 @@ def celt_lyapunov(
     """
     T = 2 * jnp.pi / params.omega_pi
     return largest_lyapunov(
-        _CeltField(get_contact_law(contact_law)),
+        CeltField(get_contact_law(contact_law)),
         y0,
         params,
         t0=t0,

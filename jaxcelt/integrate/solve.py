@@ -27,7 +27,7 @@ from jaxcelt._diffrax_adapter import use_stepsize_tol
 from jaxcelt._types import Array, ArrayLike, Scalar
 from jaxcelt.physics.contact.laws import AbstractContactLaw
 from jaxcelt.physics.contact.registry import get_contact_law
-from jaxcelt.physics.model import contact_loads, kinematics, normal_force_parts, vector_field
+from jaxcelt.physics.model import CeltField, contact_loads, kinematics, normal_force_parts
 from jaxcelt.physics.params import CeltParams
 from jaxcelt.physics.state import check_state
 
@@ -250,11 +250,7 @@ def status_code(result) -> Array:
     ).astype(jnp.int32)
 
 
-class _Field(eqx.Module):
-    law: AbstractContactLaw
-
-    def __call__(self, t, y, args):
-        return vector_field(t, y, args, self.law)
+_Field = CeltField  # the name the lane stepper imports (jaxcelt.ensemble.stepper)
 
 
 def _fill_implicit_tols(solver, rtol, atol):
@@ -312,7 +308,7 @@ def _solve(
     if stop_on_invalid:
         event = diffrax.Event(lambda t, y, args, **kw: _invalid_kind(t, y, args, law)[0] > 0)
     sol = diffrax.diffeqsolve(
-        diffrax.ODETerm(_Field(law)),
+        diffrax.ODETerm(CeltField(law)),
         mon_solver,
         t0,
         t1,

@@ -28,6 +28,9 @@ they are reported as ``trivial_multipliers``.
 
 from __future__ import annotations
 
+import dataclasses
+from typing import Unpack
+
 import diffrax
 import equinox as eqx
 import jax.numpy as jnp
@@ -35,15 +38,27 @@ import numpy as np
 
 from jaxcelt import _config  # noqa: F401
 from jaxcelt._types import Array, ArrayLike, Scalar
+from jaxcelt.orbits.branch import ArclengthBranch, continue_arclength
+from jaxcelt.orbits.options import ShootingKeywords, ShootingOptions, resolve_options
+from jaxcelt.orbits.points import BifurcationPoint, locate_bifurcation
 from jaxcelt.orbits.shooting import ORBIT_STATUS, find_periodic_orbit, sort_multipliers, stroboscopic_map
 from jaxcelt.physics.contact.laws import AbstractContactLaw
 from jaxcelt.physics.contact.registry import get_contact_law
-from jaxcelt.physics.model import contact_geometry, horizontal_frame, vector_field
+from jaxcelt.physics.model import CeltField, contact_geometry, horizontal_frame
 from jaxcelt.physics.params import CeltParams
 from jaxcelt.physics.state import check_state
 
 GUESS_MANIFOLD_TOL = 1e-3
 """How far (|n| - 1, v_A . n, r_C3 + rho . n) a guess may be off the contact manifold."""
+
+ORBIT_DEFAULTS = ShootingOptions(max_steps=200_000)
+"""`periodic_orbit`'s options (the stone needs more solver steps per period than the generic default)."""
+
+BRANCH_DEFAULTS = ShootingOptions(max_steps=200_000, newton_max_steps=8)
+"""`continue_orbit`'s options (few Newton iterations per corrector step; a step that needs more is halved)."""
+
+POINT_DEFAULTS = ShootingOptions(max_steps=200_000, newton_tol=1e-10)
+"""`locate_orbit_bifurcation`'s options."""
 
 __all__ = [
     "CeltOrbit",
@@ -53,6 +68,9 @@ __all__ = [
     "celt_chart",
     "celt_embed",
     "ORBIT_STATUS",
+    "ORBIT_DEFAULTS",
+    "BRANCH_DEFAULTS",
+    "POINT_DEFAULTS",
 ]
 
 
@@ -143,13 +161,6 @@ class CeltOrbit(eqx.Module):
         return jnp.log(self.max_multiplier) / self.period
 
 
-class _Field(eqx.Module):
-    law: AbstractContactLaw
-
-    def __call__(self, t, y, args):
-        return vector_field(t, y, args, self.law)
-
-
 def _trivial(mu_all: Array, mu_phys: Array) -> Array:
     """The 5 eigenvalues of the full monodromy left after removing the 8 physical ones (greedy)."""
     rest = mu_all
@@ -160,30 +171,24 @@ def _trivial(mu_all: Array, mu_phys: Array) -> Array:
     return sort_multipliers(rest[keep])
 
 
+def _check_params(params) -> None:
+    if not isinstance(params, CeltParams):
+        raise TypeError(f"params must be a CeltParams, got {type(params).__name__}")
+
+
+def _period(params: CeltParams) -> Array:
+    return 2 * jnp.pi / params.omega_pi
+
+
 @eqx.filter_jit
-def _orbit(params, y_guess, t0, *, k, law, solver, rtol, atol, max_steps, newton_tol, newton_max_steps):
-    T = 2 * jnp.pi / params.omega_pi
+def _orbit(params, y_guess, t0, *, k, law, options):
+    T = _period(params)
+    field = CeltField(law)
     orb = find_periodic_orbit(
-        _Field(law),
-        y_guess,
-        params,
-        period=T,
-        k=k,
-        t0=t0,
-        embed=celt_embed,
-        chart=celt_chart,
-        solver=solver,
-        rtol=rtol,
-        atol=atol,
-        max_steps=max_steps,
-        newton_tol=newton_tol,
-        newton_max_steps=newton_max_steps,
+        field, y_guess, params, period=T, k=k, t0=t0, embed=celt_embed, chart=celt_chart, options=options
     )
     # one more plain pass for the drift and psi's winding (cheap next to the variational solve)
-
-    y1, _, _ = stroboscopic_map(
-        _Field(law), orb.y, params, period=T, k=k, t0=t0, solver=solver, rtol=rtol, atol=atol, max_steps=max_steps
-    )
+    y1, _, _ = stroboscopic_map(field, orb.y, params, period=T, k=k, t0=t0, options=options)
     mu_all = jnp.linalg.eigvals(jnp.where(jnp.isfinite(orb.monodromy_full), orb.monodromy_full, 0.0))
     return CeltOrbit(
         y=orb.y,
@@ -209,12 +214,8 @@ def periodic_orbit(
     k: int = 1,
     t0: float = 0.0,
     contact_law: AbstractContactLaw | str | None = None,
-    solver: diffrax.AbstractSolver | None = None,
-    rtol: float = 1e-11,
-    atol: float = 1e-12,
-    max_steps: int = 200_000,
-    newton_tol: float = 1e-9,
-    newton_max_steps: int = 30,
+    options: ShootingOptions | None = None,
+    **settings: Unpack[ShootingKeywords],
 ) -> CeltOrbit:
     """Period-k orbit of the wobblestone near ``y_guess`` (a state at the section time t0).
 
@@ -231,13 +232,14 @@ def periodic_orbit(
             contact manifold (it is projected onto it through the chart).
         k: forcing periods per return (2 for a period-doubled orbit).
         t0: section time [s] (the base's phase omega_pi t0).
-        contact_law, solver, rtol, atol, max_steps: the model's law; diffrax settings
-            (default Dopri8, rtol 1e-11, atol 1e-12).
-        newton_tol: tolerance of the periodicity defect in chart coordinates.
-        newton_max_steps: Newton iterations at most.
+        contact_law: the model's law (default: the registry's).
+        options: `jaxcelt.orbits.options.ShootingOptions` (default `ORBIT_DEFAULTS`: Dopri8, rtol 1e-11,
+            atol 1e-12, max_steps 200 000, newton_tol 1e-9 on the periodicity defect in chart
+            coordinates, newton_max_steps 30).
+        solver, rtol, atol, max_steps, newton_tol, newton_max_steps: single fields of ``options``;
+            each one given overrides it.
     """
-    if not isinstance(params, CeltParams):
-        raise TypeError(f"params must be a CeltParams, got {type(params).__name__}")
+    _check_params(params)
     if isinstance(k, bool) or not isinstance(k, int) or k < 1:
         raise ValueError(f"periodic_orbit: 'k' must be a positive int, got {k!r}")
     # a guess need only be near the manifold: its chart coordinates are embedded back exactly
@@ -246,22 +248,9 @@ def periodic_orbit(
     y_guess = jnp.asarray(y_guess, dtype=float)
     if y_guess.shape != (13,):
         raise ValueError(f"periodic_orbit: 'y_guess' must have shape (13,), got {y_guess.shape}")
-    for name, x in (("rtol", rtol), ("atol", atol), ("newton_tol", newton_tol)):
-        if not (np.isfinite(x) and x > 0):
-            raise ValueError(f"periodic_orbit: {name!r} must be a positive finite number, got {x!r}")
-    return _orbit(
-        params,
-        y_guess,
-        jnp.asarray(t0, float),
-        k=k,
-        law=get_contact_law(contact_law),
-        solver=solver or diffrax.Dopri8(),
-        rtol=rtol,
-        atol=atol,
-        max_steps=max_steps,
-        newton_tol=newton_tol,
-        newton_max_steps=newton_max_steps,
-    )
+    opts = resolve_options(options, ORBIT_DEFAULTS, **settings)
+    opts = dataclasses.replace(opts, solver=opts.solver or diffrax.Dopri8())
+    return _orbit(params, y_guess, jnp.asarray(t0, float), k=k, law=get_contact_law(contact_law), options=opts)
 
 
 def continue_orbit(
@@ -275,18 +264,15 @@ def continue_orbit(
     ds_max: float = 0.3,
     max_points: int = 300,
     contact_law: AbstractContactLaw | str | None = None,
-    solver: diffrax.AbstractSolver | None = None,
-    rtol: float = 1e-11,
-    atol: float = 1e-12,
-    max_steps: int = 200_000,
-    newton_tol: float = 1e-9,
     bisections: int = 30,
     callback=None,
-):
+    options: ShootingOptions | None = None,
+    **settings: Unpack[ShootingKeywords],
+) -> ArclengthBranch:
     """Follow ``orbit`` (found at ``params``) in the parameter ``name`` to ``stop``.
 
     Pseudo-arclength continuation in the 8 chart coordinates of the contact manifold plus the
-    parameter (`jaxcelt.orbits.branch.continue_pseudo_arclength`, the chart re-centred on
+    parameter (`jaxcelt.orbits.branch.continue_arclength`, the chart re-centred on
     every point), so the branch passes folds; folds, period doublings (bisected) and
     Neimark-Sacker points are reported in ``bifurcations``. The section is t0 = 0 (the field
     depends on t only through the base's phase omega_pi t, so an orbit found at t0 = m T is the
@@ -301,15 +287,18 @@ def continue_orbit(
             may turn at a fold and come back on another sheet).
         ds, ds_min, ds_max, max_points: arclength step control (coordinates: m/s, rad/s, rad,
             and the parameter's own unit).
+        contact_law: the model's law.
+        options: `jaxcelt.orbits.options.ShootingOptions` (default `BRANCH_DEFAULTS`: rtol 1e-11,
+            atol 1e-12, max_steps 200 000, newton_tol 1e-9, newton_max_steps 8 per corrector step).
+        solver, rtol, atol, max_steps, newton_tol, newton_max_steps: single fields of ``options``;
+            each one given overrides it.
+        bisections: halvings of the bracket of each period doubling and Neimark-Sacker point.
         callback: ``callback(n_points, value, accepted)`` after every corrector attempt.
 
     Returns:
         `jaxcelt.orbits.branch.ArclengthBranch` (``y``: states at the section t0 = 0).
     """
-    from jaxcelt.orbits.branch import continue_pseudo_arclength
-
-    if not isinstance(params, CeltParams):
-        raise TypeError(f"params must be a CeltParams, got {type(params).__name__}")
+    _check_params(params)
     if name not in CeltParams.__dataclass_fields__ or np.ndim(getattr(params, name)) != 0:
         raise ValueError(f"continue_orbit: 'name' must be a scalar CeltParams field, got {name!r}")
     if int(np.max(np.asarray(orbit.status))) != 0 or np.ndim(orbit.status) != 0:
@@ -326,16 +315,16 @@ def continue_orbit(
         )
     else:
         stop = float(st)
-    law = get_contact_law(contact_law)
+    opts = resolve_options(options, BRANCH_DEFAULTS, **settings)
 
     def args_of(lam):
         return eqx.tree_at(lambda p: getattr(p, name), params, jnp.asarray(lam, float))
 
-    return continue_pseudo_arclength(
-        _Field(law),
+    return continue_arclength(
+        CeltField(get_contact_law(contact_law)),
         orbit.y,
         args_of,
-        lambda p: 2 * jnp.pi / p.omega_pi,
+        _period,
         lam0,
         stop,
         ds=ds,
@@ -345,11 +334,7 @@ def continue_orbit(
         k=orbit.k,
         embed=celt_embed,
         chart=celt_chart,
-        solver=solver or diffrax.Dopri8(),
-        rtol=rtol,
-        atol=atol,
-        max_steps=max_steps,
-        newton_tol=newton_tol,
+        options=dataclasses.replace(opts, solver=opts.solver or diffrax.Dopri8()),
         bisections=bisections,
         callback=callback,
     )
@@ -365,13 +350,9 @@ def locate_orbit_bifurcation(
     wrt: tuple[str, ...] = ("mu", "k_r", "b_Ts", "m_Ts"),
     k: int = 1,
     contact_law: AbstractContactLaw | str | None = None,
-    solver: diffrax.AbstractSolver | None = None,
-    rtol: float = 1e-11,
-    atol: float = 1e-12,
-    max_steps: int = 200_000,
-    newton_tol: float = 1e-10,
-    newton_max_steps: int = 30,
-):
+    options: ShootingOptions | None = None,
+    **settings: Unpack[ShootingKeywords],
+) -> BifurcationPoint:
     """Refine a fold or period doubling of a wobblestone orbit in ``name``; differentiable in ``wrt``.
 
     `jaxcelt.orbits.points.locate_bifurcation` in the chart of the contact manifold
@@ -388,18 +369,20 @@ def locate_orbit_bifurcation(
         name: the bifurcation parameter (a scalar `CeltParams` field).
         kind: ``"fold"`` (a multiplier at +1) or ``"period-doubling"`` (-1).
         wrt: the fields derivatives are carried for (the others are constants).
+        k, contact_law: periods per return; the model's law.
+        options: `jaxcelt.orbits.options.ShootingOptions` (default `POINT_DEFAULTS`: max_steps 200 000,
+            newton_tol 1e-10, the others `ShootingOptions`' defaults).
+        solver, rtol, atol, max_steps, newton_tol, newton_max_steps: single fields of ``options``;
+            each one given overrides it.
     """
-    from jaxcelt.orbits.points import locate_bifurcation
-
-    if not isinstance(params, CeltParams):
-        raise TypeError(f"params must be a CeltParams, got {type(params).__name__}")
+    _check_params(params)
     for n in (name, *wrt):
         if n not in CeltParams.__dataclass_fields__:
             raise ValueError(f"locate_orbit_bifurcation: {n!r} is not a CeltParams field")
     if name in wrt:
         raise ValueError(f"locate_orbit_bifurcation: 'wrt' must not contain the bifurcation parameter {name!r}")
     check_state(y_guess, params, name="y_guess", tol=GUESS_MANIFOLD_TOL)
-    law = get_contact_law(contact_law)
+    opts = resolve_options(options, POINT_DEFAULTS, **settings)
     theta = {n: jnp.asarray(getattr(params, n), float) for n in wrt}
 
     def args_of(lam, th):
@@ -407,20 +390,15 @@ def locate_orbit_bifurcation(
         return eqx.tree_at(lambda p: [getattr(p, n) for n in names], params, [lam, *th.values()])
 
     return locate_bifurcation(
-        _Field(law),
+        CeltField(get_contact_law(contact_law)),
         jnp.asarray(y_guess, float),
         value_guess,
         args_of,
-        lambda p: 2 * jnp.pi / p.omega_pi,
+        _period,
         theta,
         kind=kind,
         k=k,
         embed=celt_embed,
         chart=celt_chart,
-        solver=solver or diffrax.Dopri8(),
-        rtol=rtol,
-        atol=atol,
-        max_steps=max_steps,
-        newton_tol=newton_tol,
-        newton_max_steps=newton_max_steps,
+        options=dataclasses.replace(opts, solver=opts.solver or diffrax.Dopri8()),
     )

@@ -10,6 +10,9 @@ Stages (each a pure function of one sample; batch with ``jax.vmap``), MODEL.md s
 6. `normal_force`      -- N from the differentiated constraint d/dt(v_A . n) = 0 (section 8)
 7. `vector_field`      -- Newton-Euler, n_dot, r_C dot, psi dot (eqs. 1, 5, 6; section 8)
 
+`CeltField` binds a contact law to `vector_field`, giving the ``f(t, y, params)`` that diffrax and the
+orbit solvers integrate.
+
 State y = (v[3], omega[3], n[3], r_C[3], psi), 13 numbers, SI units; v, omega, n in body
 components, r_C in global components.
 """
@@ -18,6 +21,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 
@@ -40,6 +44,7 @@ __all__ = [
     "normal_force_parts",
     "vector_field",
     "vector_field_and_normal",
+    "CeltField",
     "split_state",
     "field_time",
     "STATE_NAMES",
@@ -234,6 +239,18 @@ def vector_field(
     n_dot = -w x n;  r_C_dot = R v (global);  psi_dot = (w1 n1 + w3 n3)/(1 - n2^2)
     """
     return vector_field_and_normal(t, y, params, contact_law)[0]
+
+
+class CeltField(eqx.Module):
+    """`vector_field` with its contact law bound: ``CeltField(law)(t, y, params)``, diffrax's ``f(t, y, args)``.
+
+    A module (pytree), so the law's own parameters are leaves of the term, not constants of a closure.
+    """
+
+    law: AbstractContactLaw
+
+    def __call__(self, t: ScalarLike, y: State, args: CeltParams) -> State:
+        return vector_field(t, y, args, self.law)
 
 
 def vector_field_and_normal(
