@@ -34,8 +34,8 @@ def main():
     a = ap.parse_args()
     jax.config.update("jax_num_cpu_devices", os.cpu_count() or 1)
     import jaxcelt as jc
+    from jaxcelt.ensemble import SweepConfig
     from jaxcelt.ensemble import stroboscopic as sb
-    from jaxcelt.sweeps.sweep import SweepConfig
     from jaxcelt.versions import versions
 
     V = versions()
@@ -48,12 +48,12 @@ def main():
     def run(v, cfg, reps=1, **kw):
         pb = sb.lanes_params(p, "omega_pi", v)
         t = time.perf_counter()
-        sb.run_lanes_with_stats(pb, y0[: len(v)], cfg, compile_only=True, varying=("omega_pi",), **kw)
+        sb.run_lanes(pb, y0[: len(v)], cfg, compile_only=True, varying=("omega_pi",), stats=True, **kw)
         tc = time.perf_counter() - t
         runs = []
         for _ in range(reps):
             t = time.perf_counter()
-            out, st = sb.run_lanes_with_stats(pb, y0[: len(v)], cfg, varying=("omega_pi",), **kw)
+            out, st = sb.run_lanes(pb, y0[: len(v)], cfg, varying=("omega_pi",), stats=True, **kw)
             runs.append(time.perf_counter() - t)
         status = {int(k): int(c) for k, c in zip(*np.unique(out["status"], return_counts=True))}
         return out, dict(

@@ -32,7 +32,7 @@ def main() -> None:
     import numpy as np
 
     import jaxcelt as jc
-    from jaxcelt.sweeps.sweep import SweepConfig, lanes_params, run_lanes
+    from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
     from jaxcelt.versions import versions
 
     ndev = len(jax.devices())

@@ -55,8 +55,7 @@ def main() -> None:
     sys.path.insert(0, str(HERE))
     import _numba_model as nm
 
-    from jaxcelt.ensemble.stroboscopic import run_lanes_with_stats
-    from jaxcelt.sweeps.sweep import SweepConfig, lanes_params
+    from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
     from jaxcelt.versions import versions
 
     V = versions()
@@ -81,19 +80,19 @@ def main() -> None:
             transient_periods=transient, sample_periods=a.sample, rtol=1e-8, atol=1e-10, stop_on_invalid=stop
         )
         t = time.perf_counter()
-        run_lanes_with_stats(pb, y0, cfg, pad_to=len(vals), compile_only=True, devices=devs)
+        run_lanes(pb, y0, cfg, pad_to=len(vals), compile_only=True, devices=devs, stats=True)
         compile_devices = time.perf_counter() - t
         hp = jc.HostProcesses(cores)
         t = time.perf_counter()
-        run_lanes_with_stats(pb, y0, cfg, pad_to=len(vals), compile_only=True, devices=hp)
+        run_lanes(pb, y0, cfg, pad_to=len(vals), compile_only=True, devices=hp, stats=True)
         compile_workers = time.perf_counter() - t  # worker start (imports) and compilation, in parallel
         runs: dict = {"devices": [], "processes": [], "numba": []}
         for _ in range(a.reps):
             t = time.perf_counter()
-            out, _ = run_lanes_with_stats(pb, y0, cfg, pad_to=len(vals), devices=devs)
+            out, _ = run_lanes(pb, y0, cfg, pad_to=len(vals), devices=devs, stats=True)
             runs["devices"].append(time.perf_counter() - t)
             t = time.perf_counter()
-            got, _ = run_lanes_with_stats(pb, y0, cfg, pad_to=len(vals), devices=hp)
+            got, _ = run_lanes(pb, y0, cfg, pad_to=len(vals), devices=hp, stats=True)
             runs["processes"].append(time.perf_counter() - t)
             t = time.perf_counter()
             _, st_nb, _, status_nb = nm.dopri_ensemble(y0, TS, PP, B, Bi, 1e-8, 1e-10, 10**6, stop)

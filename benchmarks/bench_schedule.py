@@ -1,7 +1,7 @@
 """Pool scheduling A/B: slots per device x pilot pause, interleaved in one process.
 
 The 400 x 300 stop-at-invalid sweep of ``bench_sweep.py`` (rtol 1e-8), run through
-`jaxcelt.sweeps.sweep.run_lanes` with each configuration in turn, ``--reps`` rounds. Every
+`jaxcelt.ensemble.run_lanes` with each configuration in turn, ``--reps`` rounds. Every
 configuration is compiled first (timed apart); the rounds interleave the configurations, so
 this VM's slow drift (10-20 % between minutes) hits them alike. Lanes are bitwise the same
 in every configuration (checked here); only the schedule differs.
@@ -33,8 +33,8 @@ def main() -> None:
     jax.config.update("jax_num_cpu_devices", os.cpu_count() or 1)
 
     import jaxcelt as jc
+    from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
     from jaxcelt.integrate.solvers import make_solver
-    from jaxcelt.sweeps.sweep import SweepConfig, lanes_params, run_lanes
     from jaxcelt.versions import versions
 
     configs = [(s, int(w), float(f)) for s, w, f in (c.split(":") for c in a.configs.split(","))]

@@ -26,11 +26,10 @@ import jax.numpy as jnp
 import numpy as np
 
 import jaxcelt as jc
-from jaxcelt.ensemble import make_stepper
+from jaxcelt.ensemble import lanes_params, make_stepper
 from jaxcelt.integrate.solve import DEFAULT_SOLVER, _invalid_kind
 from jaxcelt.physics.contact.registry import get_contact_law
 from jaxcelt.physics.model import vector_field
-from jaxcelt.sweeps.sweep import lanes_params
 
 PARTS = (
     "rhs",

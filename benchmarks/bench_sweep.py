@@ -39,7 +39,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 import _numba_model as nm  # noqa: E402
 
 import jaxcelt as jc  # noqa: E402
-from jaxcelt.sweeps.sweep import bifurcation  # noqa: E402
+from jaxcelt.sweeps.api import bifurcation  # noqa: E402
 from jaxcelt.versions import versions  # noqa: E402
 
 LANE_STEPS: dict = {}  # (stop_on_invalid, solver, devices) -> per-lane steps of a jaxcelt pool run
@@ -93,7 +93,7 @@ def time_jaxcelt(p, vals, transient, a, scheduler, stop, devices, solver=None, r
     """Compile apart, then the sweep; step-slot accounting from the pool's loop counters."""
     import diffrax
 
-    from jaxcelt.sweeps.sweep import SweepConfig, lanes_params, run_lanes
+    from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
 
     solver = solver if solver is not None else diffrax.Tsit5()
     kw = dict(
@@ -251,7 +251,7 @@ def main():
     ap.add_argument("--out", type=Path, default=Path("docs/bifurcation"))
     a = ap.parse_args()
     if a.width is None:
-        from jaxcelt.sweeps.sweep import DEFAULT_WIDTH
+        from jaxcelt.ensemble import DEFAULT_WIDTH
 
         a.width = DEFAULT_WIDTH
     n_host = (os.cpu_count() or 1) if a.host_devices == "auto" else int(a.host_devices)

@@ -31,7 +31,7 @@ CHILD = r"""
 import json, sys, time, numpy as np
 w0, c0 = time.perf_counter(), time.process_time()
 import jax, jaxcelt as jc
-from jaxcelt.sweeps.sweep import SweepConfig, lanes_params, run_lanes
+from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
 from jaxcelt.identify.records import generate_data
 out = {"XLA_FLAGS": __import__("os").environ.get("XLA_FLAGS", "")}
 p = jc.CeltParams.paper()

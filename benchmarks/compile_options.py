@@ -39,12 +39,12 @@ def child(variant: str) -> dict:
     y0 = np.tile(np.asarray(jc.initial_state(p)), (len(vals), 1))
     cfg = sb.SweepConfig(transient_periods=100, sample_periods=30, stop_on_invalid=True)
     pb = sb.lanes_params(p, "omega_pi", vals)
-    out, st = sb.run_lanes_with_stats(pb, y0, cfg, varying=("omega_pi",))
+    out, st = sb.run_lanes(pb, y0, cfg, varying=("omega_pi",), stats=True)
     lcfg = sb.SweepConfig(transient_periods=0, sample_periods=30, lyapunov_periods=30, stop_on_invalid=True)
     mesh = device_mesh(None)
     ndev = mesh.devices.size
     ok = np.flatnonzero(out["status"] == 0)
-    G = st.width * ndev  # as run_lanes_with_stats: one chunk of the pool's width
+    G = st.width * ndev  # as run_lanes: one chunk of the pool's width
     idx = pad_lanes(ok[:G], G)
     pb_np = jax.tree_util.tree_map(np.asarray, pb)
     args = (jax.tree_util.tree_map(lambda x: x[idx], pb_np), out["samples"][idx, 0], out["t_samples"][idx, 0], lcfg, mesh)

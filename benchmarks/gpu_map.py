@@ -80,9 +80,8 @@ def main() -> int:
         return 0
 
     import jaxcelt as jc
-    from jaxcelt.ensemble import lanes_params, run_lanes
+    from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
     from jaxcelt.plotting.map import map_categories
-    from jaxcelt.sweeps.sweep import SweepConfig
     from jaxcelt.versions import versions
 
     ver = versions()
@@ -164,8 +163,7 @@ def check(a) -> dict:
     import jax
 
     import jaxcelt as jc
-    from jaxcelt.ensemble import run_lanes
-    from jaxcelt.sweeps.sweep import SweepConfig
+    from jaxcelt.ensemble import SweepConfig, run_lanes
     from jaxcelt.versions import versions
 
     p = jc.CeltParams.paper()

@@ -38,7 +38,8 @@ PRE_IMPORTED = (
     "PIL.Image",
     "jaxcelt.cli",
     "jaxcelt.sweeps.dataset",
-    "jaxcelt.sweeps.sweep",
+    "jaxcelt.sweeps.api",
+    "jaxcelt.sweeps.dense",
     "jaxcelt.plotting.bifurcation",
 )
 

@@ -45,8 +45,7 @@ def child(variant: str, mode: str, n_freq: int, periods: int, sample: int, runs:
 
     import jaxcelt as jc
     import jaxcelt._compile_options as co
-    from jaxcelt.ensemble.stroboscopic import run_lanes_with_stats
-    from jaxcelt.sweeps.sweep import SweepConfig, lanes_params
+    from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
 
     if variant == "256":
         co.WIDE_VECTORS.clear()  # the pool compiled with XLA's defaults
@@ -59,12 +58,12 @@ def child(variant: str, mode: str, n_freq: int, periods: int, sample: int, runs:
     y0 = np.tile(np.asarray(jc.initial_state(p)), (n_freq, 1))
     kw = dict(pad_to=n_freq, devices=jax.devices())
     t = time.perf_counter()
-    run_lanes_with_stats(pb, y0, cfg, compile_only=True, **kw)
+    run_lanes(pb, y0, cfg, compile_only=True, stats=True, **kw)
     compile_s = time.perf_counter() - t
     times = []
     for _ in range(runs):
         t = time.perf_counter()
-        out, st = run_lanes_with_stats(pb, y0, cfg, **kw)
+        out, st = run_lanes(pb, y0, cfg, stats=True, **kw)
         times.append(time.perf_counter() - t)
     status = np.bincount(np.asarray(out["status"]), minlength=4)
     return dict(

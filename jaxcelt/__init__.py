@@ -34,8 +34,11 @@ from jaxcelt.physics.model import STATE_NAMES, kinematics, normal_force, vector_
 from jaxcelt.physics.params import PARAM_NAMES, CeltParams
 from jaxcelt.physics.state import check_state, constraint_residual, initial_state
 from jaxcelt.studies.ladder import Scene, hertz_params, run_ladder
+from jaxcelt.sweeps.api import bifurcation, parameter_map, sweep_lanes
 from jaxcelt.sweeps.census import AttractorCensus, AttractorStarts, attractor_starts, attractors
-from jaxcelt.sweeps.sweep import SweepResult, bifurcation, continuation, parameter_map, sweep_lanes
+from jaxcelt.sweeps.following import continuation
+from jaxcelt.sweeps.following import follow_attractor as follow_attractor  # new name of continuation
+from jaxcelt.sweeps.result import SweepResult
 
 __version__ = "0.1.0"
 

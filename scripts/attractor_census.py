@@ -1,7 +1,7 @@
 """Attractor census of the wobblestone at omega_pi = 14, 15.6, 17, 19 rad/s (paper parameters).
 
 Every frequency: a psi0 x tilt grid of starts at rest (`jaxcelt.attractor_starts`), each run as
-one lane of `jaxcelt.sweeps.sweep` (`jaxcelt.attractors`): transient, then stroboscopic samples,
+one lane of `jaxcelt.sweeps.api.sweep` (`jaxcelt.attractors`): transient, then stroboscopic samples,
 labelled periodic-k / quasi-periodic / chaotic / aperiodic / invalid / failed; periodic lanes
 grouped into distinct attractors. Resumable per frequency: a frequency whose result (with the same grid, tilt and
 periods) is in ``<out>/census/omega_<w>.json`` is skipped. Writes ``<out>/census.json`` (all frequencies:

@@ -31,8 +31,8 @@ def main() -> int:
 
     import jaxcelt as jc
     from jaxcelt.plotting.map import map_categories
+    from jaxcelt.sweeps.api import sweep_lanes
     from jaxcelt.sweeps.regimes import REGIMES
-    from jaxcelt.sweeps.sweep import sweep_lanes
     from jaxcelt.versions import versions
 
     names = [c[0] for c in map_categories(np.zeros(0, int), np.zeros(0, int))[1]]

@@ -5,7 +5,7 @@
 Writes ``fig3_<tag>.png`` (omega_2 at the section against omega_pi, coloured by regime) and
 ``fig4-7_<tag>_w<omega>.png`` (local phase plot omega_1-omega_3, global path of O, section) for
 omega_pi = 14, 15.6, 17, 19, plus ``figures_<tag>.json`` with the labels shown. Uses only the
-library (`jaxcelt.bifurcation`, `jaxcelt.sweeps.sweep.orbit`, `jaxcelt.plotting.bifurcation`).
+library (`jaxcelt.bifurcation`, `jaxcelt.sweeps.dense.dense_trajectory`, `jaxcelt.plotting.bifurcation`).
 """
 
 from __future__ import annotations
@@ -21,10 +21,11 @@ matplotlib.use("Agg")
 import numpy as np  # noqa: E402
 
 import jaxcelt as jc  # noqa: E402
+from jaxcelt.ensemble import SweepConfig  # noqa: E402
 from jaxcelt.plotting.bifurcation import bifurcation_figure, orbit_figure  # noqa: E402
 from jaxcelt.sweeps.dataset import to_dataset  # noqa: E402
+from jaxcelt.sweeps.dense import dense_trajectory  # noqa: E402
 from jaxcelt.sweeps.regimes import GLOBAL_MOTION, classify, regime_names  # noqa: E402
-from jaxcelt.sweeps.sweep import SweepConfig, orbit  # noqa: E402
 from jaxcelt.versions import versions  # noqa: E402
 
 PAPER = {
@@ -80,7 +81,7 @@ def main(argv=None):
         info["diagram_wall_s"] = time.perf_counter() - t
     for w in PAPER:
         q = p.replace(omega_pi=w)
-        o = orbit(q, y0, transient_periods=args.transient, periods=args.orbit_periods, points_per_period=40)
+        o = dense_trajectory(q, y0, transient_periods=args.transient, periods=args.orbit_periods, points_per_period=40)
         si = np.asarray(o["section_index"])
         samples = np.asarray(o["ys"])[si][None]
         lab = classify(samples, np.array([o["status"]]), np.array([True]), np.asarray(o["r_O"])[si][None])

@@ -3,7 +3,7 @@
 The paper (section 3, Figs. 4-7) reports for q_pi = 0.04 m:
   14 rad/s periodic, bounded;  15.6 periodic (locally), unbounded;  17 quasi-periodic, bounded;
   19 chaotic, (seemingly) unbounded.
-Everything the text leaves open is swept in one vmapped batch of lanes (`jaxcelt.sweeps.sweep.run_lanes`):
+Everything the text leaves open is swept in one vmapped batch of lanes (`jaxcelt.ensemble.run_lanes`):
 the reading switches v_pi_sign and derivative_exact (MODEL.md section 9), the smoothing eps = eps_R,
 initial conditions (rest at several headings psi0, small roll/pitch rocking, slow spin) and the
 transient length; each lane is labelled with `jaxcelt.sweeps.regimes.classify` (section period, largest
@@ -29,8 +29,8 @@ from pathlib import Path
 import numpy as np
 
 import jaxcelt as jc
+from jaxcelt.ensemble import SweepConfig, run_lanes
 from jaxcelt.sweeps.regimes import GLOBAL_MOTION, classify, regime_names
-from jaxcelt.sweeps.sweep import SweepConfig, run_lanes
 from jaxcelt.versions import versions
 
 PAPER = {

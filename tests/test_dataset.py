@@ -13,8 +13,8 @@ import pytest
 import xarray as xr
 from _sweep_common import KW, VALUES
 
+from jaxcelt.sweeps.api import bifurcation
 from jaxcelt.sweeps.dataset import DamagedChunkWarning, open_sweep
-from jaxcelt.sweeps.sweep import bifurcation
 
 VALUES8 = np.concatenate([VALUES, VALUES + 0.5])  # 2 chunks of the shared chunk shape (4 lanes)
 
@@ -157,6 +157,23 @@ def test_lane_fields_match_sweep_result():
     import dataclasses
 
     from jaxcelt.sweeps.dataset import LANE_FIELDS
-    from jaxcelt.sweeps.sweep import SweepResult
+    from jaxcelt.sweeps.result import SweepResult
 
     assert LANE_FIELDS == tuple(f.name for f in dataclasses.fields(SweepResult) if f.name not in ("name", "values"))
+
+
+def test_fingerprint_of_a_fixed_sweep_is_pinned(tmp_path):
+    # an out/ directory written by earlier versions resumes only if the manifest's fingerprint is
+    # computed as it was: this value is the one the released 0.1.0 layout (jaxcelt.sweep,
+    # jaxcelt.dataset) wrote for this sweep; moving or renaming the sweep's classes must not change it
+    import jaxcelt as jc
+    from jaxcelt.sweeps.dataset import SweepWriter
+    from jaxcelt.sweeps.options import SweepOptions
+
+    cfg = SweepOptions(transient_periods=5, sample_periods=4, stop_on_invalid=True).config()
+    p = jc.CeltParams.paper()
+    vals = np.linspace(14, 16, 6)
+    y0 = np.tile(np.asarray(jc.initial_state(p)), (6, 1))
+    chunks = [np.array([0, 1]), np.array([2, 3]), np.array([4, 5])]
+    w = SweepWriter(tmp_path, params=p, name="omega_pi", lane_values=vals, lane_y0=y0, n_starts=1, config=cfg, chunks=chunks)
+    assert w.fingerprint == "88a0e7af8310975a9cbf4c6db259a293f22e4e13459d183a2036cc56b10d9ba2"

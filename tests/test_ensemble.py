@@ -89,9 +89,9 @@ def test_pool_stats_follow_the_schedule(fused):
 @pytest.mark.parametrize(("name", "value"), [("drain_factor", 1), ("drain_factor", 2.5), ("min_drain_width", 0)])
 def test_drain_options_are_checked(paper_params, name, value):
     # checked before anything is traced: a clear error naming the option
-    from jaxcelt.ensemble.stroboscopic import SweepConfig, run_lanes_with_stats
+    from jaxcelt.ensemble.stroboscopic import SweepConfig, run_lanes
 
     pb = lanes_params(paper_params, "omega_pi", VALUES[:2])
     y0 = np.tile(np.asarray(jc.initial_state(paper_params)), (2, 1))
     with pytest.raises(ValueError, match=name):
-        run_lanes_with_stats(pb, y0, SweepConfig(transient_periods=1, sample_periods=1), **{name: value})
+        run_lanes(pb, y0, SweepConfig(transient_periods=1, sample_periods=1), stats=True, **{name: value})

@@ -66,7 +66,7 @@ def test_celt_projection_keeps_manifold(paper_params):
 @pytest.mark.slow
 def test_celt_vmapped_matches_single(paper_params):
     y0 = jc.initial_state(paper_params)
-    from jaxcelt.sweeps.sweep import lanes_params
+    from jaxcelt.ensemble import lanes_params
 
     pb = lanes_params(paper_params, "omega_pi", jnp.array([14.0, 17.0]))
     f = jax.jit(jax.vmap(lambda p, y: celt_lyapunov(p, y, periods=3)))

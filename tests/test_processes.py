@@ -6,8 +6,7 @@ import numpy as np
 import pytest
 
 import jaxcelt as jc
-from jaxcelt.ensemble.stroboscopic import run_lanes_with_stats
-from jaxcelt.sweeps.sweep import SweepConfig, lanes_params
+from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
 
 
 @pytest.fixture(scope="module")
@@ -39,9 +38,9 @@ def test_an_error_in_a_worker_is_raised_here(workers):
     pb = lanes_params(p, "omega_pi", np.array([12.0, 14.0, 16.0]))
     y0 = np.tile(np.asarray(jc.initial_state(p)), (3, 1))
     with pytest.raises(ValueError, match="drain_factor"):
-        run_lanes_with_stats(pb, y0, SweepConfig(transient_periods=1, sample_periods=1), devices=workers, drain_factor=1)
+        run_lanes(pb, y0, SweepConfig(transient_periods=1, sample_periods=1), devices=workers, drain_factor=1, stats=True)
     # the workers still serve the next chunk
-    out, stats = run_lanes_with_stats(pb, y0, SweepConfig(transient_periods=1, sample_periods=1), devices=workers)
+    out, stats = run_lanes(pb, y0, SweepConfig(transient_periods=1, sample_periods=1), devices=workers, stats=True)
     assert out["status"].tolist() == [0, 0, 0] and stats.slot_steps >= out["num_steps"].sum()
 
 

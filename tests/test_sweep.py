@@ -1,5 +1,5 @@
 """Sweeps: vmapped lanes equal single `simulate` runs, failing lanes are isolated, sharding is
-transparent, continuation carries states. Compared against `jaxcelt.simulate` (the core
+transparent, following an attractor carries states. Compared against `jaxcelt.simulate` (the core
 entry point, not written for the sweep) and against numpy recomputation of the section times."""
 
 import dataclasses
@@ -15,7 +15,10 @@ import pytest
 from _sweep_common import KW, SAMPLE_ATOL, VALUES, assert_same_lanes
 
 import jaxcelt as jc
-from jaxcelt.sweeps.sweep import bifurcation, continuation, lanes_params, parse_range
+from jaxcelt.commands.args import parse_range
+from jaxcelt.ensemble import lanes_params
+from jaxcelt.sweeps.api import bifurcation
+from jaxcelt.sweeps.following import follow_attractor
 
 
 @pytest.fixture(scope="module")
@@ -62,12 +65,13 @@ def test_lyapunov_stage_equals_celt_lyapunov_and_starts_deferred_work(paper_para
     # program. Where rounding flips an accept decision the step sequences part and the two differ
     # at the solver tolerance (rtol 1e-8 over 2 periods), far below 1e-6 1/s; a wrong start, time or
     # period count changes lambda by ~0.1 1/s. The stage also starts programs deferred for later
-    # (`prepare_orbit(defer=True)`): queued before the sweep, started by it, then used by `orbit`.
+    # (`prepare_dense_trajectory(defer=True)`): queued before the sweep, started by it, then used by
+    # `dense_trajectory`.
     from jaxcelt import _executable_cache as ec
-    from jaxcelt.sweeps.sweep import orbit, prepare_orbit
+    from jaxcelt.sweeps.dense import dense_trajectory, prepare_dense_trajectory
 
     okw = dict(transient_periods=1, periods=1, points_per_period=3)
-    prepare_orbit(paper_params.replace(omega_pi=14.0), defer=True, **okw)
+    prepare_dense_trajectory(paper_params.replace(omega_pi=14.0), defer=True, **okw)
     assert ec._DEFERRED
     vals = np.array([14.0, 17.0])
     r = bifurcation(paper_params, vals, **{**KW, "chunk_size": 2}, lyapunov_periods=2)
@@ -78,7 +82,7 @@ def test_lyapunov_stage_equals_celt_lyapunov_and_starts_deferred_work(paper_para
         assert np.isfinite(r.lyapunov[i]), w
         np.testing.assert_allclose(r.lyapunov[i], float(lr.exponent), rtol=0, atol=1e-6, err_msg=str(w))
     n = len(ec._MEMORY)
-    o = orbit(paper_params.replace(omega_pi=17.0), **okw)
+    o = dense_trajectory(paper_params.replace(omega_pi=17.0), **okw)
     assert o["status"] == 0 and len(ec._MEMORY) == n  # the deferred program, not a new one
 
 
@@ -89,7 +93,7 @@ def test_failing_lane_is_isolated(base, paper_params):
     # another program than the base sweep, so rounding may differ; see _sweep_common).
     y0 = np.asarray(jc.initial_state(paper_params))
     params = paper_params
-    from jaxcelt.sweeps.sweep import SweepConfig, run_lanes
+    from jaxcelt.ensemble import SweepConfig, run_lanes
 
     cfg = SweepConfig(transient_periods=3, sample_periods=4, max_steps=4000)
     pb = lanes_params(params, "omega_pi", VALUES)
@@ -122,7 +126,7 @@ def test_bad_inputs(paper_params):
 
 @pytest.mark.slow
 def test_continuation_carries_state(paper_params):
-    res = continuation(paper_params, "omega_pi", [16.0, 16.5], direction="up", transient_periods=2, sample_periods=2)
+    res = follow_attractor(paper_params, "omega_pi", [16.0, 16.5], direction="up", transient_periods=2, sample_periods=2)
     up = res["up"]
     assert up.samples.shape == (2, 1, 2, 13)
     # the second value started where the first ended: rerun it by hand from that state
@@ -140,7 +144,7 @@ def test_two_host_devices_equal_one():
     code = textwrap.dedent(
         """
         import jax, numpy as np, jaxcelt as jc
-        from jaxcelt.sweeps.sweep import bifurcation
+        from jaxcelt.sweeps.api import bifurcation
         assert len(jax.local_devices()) == 2, jax.local_devices()
         p = jc.CeltParams.paper()
         v = np.array([12.0, 14.0, 17.0, 19.0])
@@ -230,7 +234,7 @@ def test_pool_other_solvers_equal_simulate(paper_params, solver):
     # on the samples and 3 % on the step count -- what "same method, same tolerance" means.
     import diffrax
 
-    from jaxcelt.sweeps.sweep import SweepConfig, _erk_tableau
+    from jaxcelt.ensemble.stroboscopic import SweepConfig, _erk_tableau
 
     s = getattr(diffrax, solver)()
     fused = _erk_tableau(SweepConfig(solver=s)) is not None
@@ -259,7 +263,7 @@ def test_pool_drain_compaction_keeps_lanes(paper_params):
     # with a pool that is 8 wide from the start. Different widths are different compiled programs
     # (on an AVX-512 CPU ~half the samples differ at <= 1.6e-12 relative), so: same step
     # counts and statuses, samples within SAMPLE_ATOL (see _sweep_common).
-    from jaxcelt.sweeps.sweep import SweepConfig, run_lanes
+    from jaxcelt.ensemble import SweepConfig, run_lanes
 
     vals = np.linspace(12.0, 19.0, 40)
     y0 = np.tile(np.asarray(jc.initial_state(paper_params)), (len(vals), 1))
@@ -280,7 +284,7 @@ def test_wide_vector_pool_keeps_lanes(paper_params):
     # compiled programs that may round differently (on a CPU without AVX-512 they are the same).
     # Lanes must not depend on it: same step counts and statuses, samples within SAMPLE_ATOL.
     from jaxcelt._compile_options import WIDE_VECTORS_MIN_SLOTS, pool_compiler_options
-    from jaxcelt.sweeps.sweep import SweepConfig, run_lanes
+    from jaxcelt.ensemble import SweepConfig, run_lanes
 
     W = WIDE_VECTORS_MIN_SLOTS
     assert pool_compiler_options("cpu", W) == {"xla_cpu_prefer_vector_width": 512}
@@ -302,8 +306,8 @@ def test_narrow_pool_inner_loop_keeps_lanes(paper_params):
     # invalid and lanes that run out of steps) must equal the same lanes through 12 slots stepped
     # once per iteration. Another width is another compiled program: same steps and statuses,
     # floats within SAMPLE_ATOL (min_N to rtol 1e-7, as in the pilot test below).
+    from jaxcelt.ensemble import SweepConfig, run_lanes
     from jaxcelt.ensemble.pool import SEQUENTIAL_WIDTH
-    from jaxcelt.sweeps.sweep import SweepConfig, run_lanes
 
     # from rest, omega_pi = 10 and 10.5 need > 3000 steps to their first invalid state (~4.9
     # periods), 11.5 and 12.25 ~2100-2300 (~5.5-6 periods); 14-19 stay valid over 7 periods.
@@ -339,7 +343,7 @@ def test_pool_pilot_pause_keeps_lanes(paper_params):
     # run out of steps (max_steps: status 1) and lanes that stop invalid. The pilot is another
     # compiled program, so: same steps and statuses, floats within SAMPLE_ATOL (min_N to rtol
     # 1e-7: N is a stiff function of the state, see test_sweep_equals_single_simulate).
-    from jaxcelt.sweeps.sweep import SweepConfig, run_lanes
+    from jaxcelt.ensemble import SweepConfig, run_lanes
 
     vals = np.linspace(10.0, 19.0, 40)
     y0 = np.tile(np.asarray(jc.initial_state(paper_params)), (len(vals), 1))
@@ -542,8 +546,8 @@ def test_two_processes_equal_one(paper_params, tmp_path):
 
 
 def open_sweep_regimes(result, params):
+    from jaxcelt.ensemble import SweepConfig
     from jaxcelt.sweeps.dataset import to_dataset
-    from jaxcelt.sweeps.sweep import SweepConfig
 
     cfg = SweepConfig(**{k: v for k, v in KW.items() if k != "chunk_size"})
     return to_dataset(result, params, cfg)["regime"].values
@@ -574,7 +578,7 @@ def test_float32_pool_over_300_periods(paper_params):
     om = np.repeat([15.0, 17.5, 20.0], 2)
     q = np.tile([0.04, 0.06], 3)
     kw = dict(transient_periods=270, sample_periods=30, stop_on_invalid=True, rtol=1e-6, atol=1e-8)
-    from jaxcelt.sweeps.sweep import sweep_lanes
+    from jaxcelt.sweeps.api import sweep_lanes
 
     r64 = sweep_lanes(paper_params, {"omega_pi": om, "q_pi": q}, **kw)
     r32 = sweep_lanes(paper_params, {"omega_pi": om, "q_pi": q}, dtype="float32", **kw)
@@ -589,7 +593,7 @@ def test_sweep_lanes_any_batch_equals_bifurcation(base, paper_params, tmp_path):
     """`sweep_lanes` over an arbitrary batch (omega_pi and q_pi drawn per lane, shuffled, plus one
     lane with another start): each lane equals the `bifurcation` lane with the same parameters and
     start (another compiled program: same steps and status, samples within SAMPLE_ATOL)."""
-    from jaxcelt.sweeps.sweep import sweep_lanes
+    from jaxcelt.sweeps.api import sweep_lanes
 
     om = np.array([17.0, 12.0, 19.0, 14.0, 17.0])
     q = np.array([0.04, 0.04, 0.04, 0.04, 0.05])
@@ -614,14 +618,14 @@ def test_sweep_lanes_any_batch_equals_bifurcation(base, paper_params, tmp_path):
 
 
 def test_orbit_equals_simulate(paper_params):
-    # `orbit` (the phase plots' trajectories) is `simulate` stepping onto the save times, compiled
+    # `dense_trajectory` (the phase plots' trajectories) is `simulate` stepping onto the save times, compiled
     # as its own program with XLA's loop emitters: the same steps, so states equal to rounding
     # (SAMPLE_ATOL, see _sweep_common), and the centre O of `centre_position` at every state.
     from jaxcelt.physics.diagnostics import centre_position
-    from jaxcelt.sweeps.sweep import orbit
+    from jaxcelt.sweeps.dense import dense_trajectory
 
     p = paper_params.replace(omega_pi=17.0)
-    o = orbit(p, transient_periods=2, periods=3, points_per_period=8)
+    o = dense_trajectory(p, transient_periods=2, periods=3, points_per_period=8)
     sol = jc.simulate(p, jc.initial_state(p), o["ts"][-1], ts=o["ts"], exact_ts=True)
     assert o["status"] == int(sol.status) == 0 and o["valid"]
     np.testing.assert_allclose(o["ys"], np.asarray(sol.ys), rtol=0, atol=SAMPLE_ATOL)
@@ -630,28 +634,28 @@ def test_orbit_equals_simulate(paper_params):
     T = 2 * np.pi / 17.0
     np.testing.assert_allclose(o["ts"][o["section_index"]], T * (2 + np.arange(4)), rtol=1e-14)
     with pytest.raises(ValueError, match="rtol"):
-        orbit(p, transient_periods=1, periods=1, rtol=-1.0)
+        dense_trajectory(p, transient_periods=1, periods=1, rtol=-1.0)
     with pytest.raises(ValueError, match="y0"):
-        orbit(p, np.zeros(13), transient_periods=1, periods=1)
+        dense_trajectory(p, np.zeros(13), transient_periods=1, periods=1)
     with pytest.raises(ValueError, match="periods"):
-        orbit(p, transient_periods=1, periods=0)
+        dense_trajectory(p, transient_periods=1, periods=0)
 
 
 def test_prepare_orbit_compiles_the_program_orbit_runs(paper_params):
-    # `prepare_orbit` traces now and compiles on a worker thread; a later `orbit` with the same
+    # `prepare_dense_trajectory` traces now and compiles on a worker thread; a later `dense_trajectory` with the same
     # settings and another parameter value and start must run that program (one new executable in
     # the process's store, not two) and give what a fresh `simulate` gives (SAMPLE_ATOL).
     from jaxcelt import _executable_cache as ec
-    from jaxcelt.sweeps.sweep import orbit, prepare_orbit
+    from jaxcelt.sweeps.dense import dense_trajectory, prepare_dense_trajectory
 
     kw = dict(transient_periods=1, periods=2, points_per_period=5)
     p1, p2 = paper_params.replace(omega_pi=14.0), paper_params.replace(omega_pi=16.0)
     n0 = len(ec._MEMORY)
-    assert prepare_orbit(p1, **kw) is None
+    assert prepare_dense_trajectory(p1, **kw) is None
     assert len(ec._MEMORY) == n0 + 1
-    o = orbit(p2, jc.initial_state(p2, omega=[0.0, 1.0, 0.0]), **kw)
+    o = dense_trajectory(p2, jc.initial_state(p2, omega=[0.0, 1.0, 0.0]), **kw)
     assert len(ec._MEMORY) == n0 + 1
     sol = jc.simulate(p2, jc.initial_state(p2, omega=[0.0, 1.0, 0.0]), o["ts"][-1], ts=o["ts"], exact_ts=True)
     np.testing.assert_allclose(o["ys"], np.asarray(sol.ys), rtol=0, atol=SAMPLE_ATOL)
     with pytest.raises(ValueError, match="atol"):
-        prepare_orbit(p1, atol=0.0, **kw)
+        prepare_dense_trajectory(p1, atol=0.0, **kw)

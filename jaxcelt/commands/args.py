@@ -15,14 +15,22 @@ class UsageError(ValueError):
     """Bad command-line input found by a command itself (the CLI prints it as one error line)."""
 
 
-def _number(s: str, kind=float):
+def _parse_number(s: str, kind=float):
+    """``s`` as a finite float or an int; ValueError saying what was expected."""
     try:
         v = kind(s.strip())
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected {'an integer' if kind is int else 'a number'}, got {s!r}") from None
+        raise ValueError(f"expected {'an integer' if kind is int else 'a number'}, got {s!r}") from None
     if kind is float and not math.isfinite(v):
-        raise argparse.ArgumentTypeError(f"expected a finite number, got {s!r}")
+        raise ValueError(f"expected a finite number, got {s!r}")
     return v
+
+
+def _number(s: str, kind=float):
+    try:
+        return _parse_number(s, kind)
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
 
 
 def finite_float(s: str) -> float:
@@ -67,21 +75,30 @@ def floats(n: int):
     return parse
 
 
-def value_range(s: str):
+def parse_range(s: str):
     """``START:STOP:COUNT`` (COUNT evenly spaced values, ends included) or a list ``a,b,c``; ``''`` is empty.
 
-    Returns a NumPy array (the same values as `jaxcelt.sweeps.sweep.parse_range`)."""
+    Returns a NumPy array of finite numbers; ValueError saying what is wrong otherwise. The one
+    parser of value ranges (the commands' `value_range`; formerly also ``jaxcelt.sweep.parse_range``)."""
     import numpy as np
 
     if ":" in s:
         parts = s.split(":")
         if len(parts) != 3:
-            raise argparse.ArgumentTypeError(f"expected START:STOP:COUNT, got {s!r}")
-        a, b, n = _number(parts[0]), _number(parts[1]), _number(parts[2], int)
+            raise ValueError(f"expected START:STOP:COUNT, got {s!r}")
+        a, b, n = _parse_number(parts[0]), _parse_number(parts[1]), _parse_number(parts[2], int)
         if n < 1:
-            raise argparse.ArgumentTypeError(f"COUNT must be >= 1, got {s!r}")
+            raise ValueError(f"COUNT must be >= 1, got {s!r}")
         return np.linspace(a, b, n)
-    return np.array([_number(x) for x in s.split(",") if x.strip()], dtype=float)
+    return np.array([_parse_number(x) for x in s.split(",") if x.strip()], dtype=float)
+
+
+def value_range(s: str):
+    """`parse_range` as an argument type: ``START:STOP:COUNT`` or a list ``a,b,c`` -> a NumPy array."""
+    try:
+        return parse_range(s)
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
 
 
 def override(s: str) -> tuple[str, float]:
@@ -92,6 +109,11 @@ def override(s: str) -> tuple[str, float]:
     if not k.strip():
         raise argparse.ArgumentTypeError(f"expected NAME=VALUE, got {s!r}")
     return k.strip(), _number(v)
+
+
+def add_set_flag(p: argparse.ArgumentParser, help: str = "override any CeltParams field, repeatable") -> None:
+    """The ``--set NAME=VALUE`` flag (repeatable; read it with `overrides`)."""
+    p.add_argument("--set", action="append", type=override, default=[], metavar="NAME=VALUE", help=help)
 
 
 def overrides(items: list[tuple[str, float]]) -> dict[str, float]:

@@ -13,20 +13,9 @@ import json
 import time
 from pathlib import Path
 
-from jaxcelt.commands.args import (
-    UsageError,
-    floats,
-    nonnegative_int,
-    override,
-    overrides,
-    positive_float,
-    positive_int,
-    value_range,
-)
-
-ENGINES = ("auto", "pool", "kernel")
-"""`jaxcelt.ensemble.ENGINES`, written out: the CLI parses its arguments before it imports JAX"""
-SWEEP_SOLVERS = ("Tsit5", "Dopri5", "Dopri8")  # names in jaxcelt.studies.benchmarking.SOLVERS
+from jaxcelt.commands._sweep_flags import ENGINES as ENGINES
+from jaxcelt.commands._sweep_flags import add_sweep_flags, lane_devices, run_settings
+from jaxcelt.commands.args import UsageError, overrides, positive_int, value_range
 
 
 def register(sub) -> None:
@@ -46,61 +35,26 @@ def register(sub) -> None:
         default=None,
         help="values of --param when it is not omega_pi (START:STOP:COUNT or list)",
     )
-    p.add_argument("--transient", type=nonnegative_int, default=100, help="transient forcing periods discarded")
-    p.add_argument("--sample", type=positive_int, default=30, help="stroboscopic samples (periods) kept")
-    p.add_argument(
-        "--lyapunov",
-        type=nonnegative_int,
-        default=150,
-        help="periods of tangent dynamics for the Lyapunov exponent (0: off); labels need a long window "
-        "(the exponent's standard error shrinks roughly as 1/sqrt(periods))",
-    )
-    p.add_argument(
-        "--set",
-        action="append",
-        type=override,
-        default=[],
-        metavar="NAME=VALUE",
-        help="override any CeltParams field, repeatable",
-    )
-    p.add_argument("--omega0", type=floats(3), default="0,0,0", help="initial omega (body) [rad/s]")
-    p.add_argument(
-        "--solver",
-        default="Tsit5",
-        choices=SWEEP_SOLVERS,
-        help="explicit Runge-Kutta method (adaptive, PID control, section times hit exactly). Dopri8 is the same "
-        "8th-order Dormand-Prince family as scipy's DOP853: at rtol 1e-8 about 25x more accurate than Tsit5, "
-        "as fast per sweep, but it compiles longer",
-    )
-    p.add_argument("--rtol", type=positive_float, default=1e-8)
-    p.add_argument("--atol", type=positive_float, default=1e-10)
-    p.add_argument("--max-steps", type=positive_int, default=1_000_000)
-    p.add_argument(
-        "--chunk-size",
-        type=positive_int,
-        default=200,
-        help="lanes per jitted pool launch (the unit of resumable writing); split over the devices",
-    )
-    p.add_argument(
-        "--width",
-        type=positive_int,
-        default=None,
-        help="pool slots per device: lanes stepped side by side (vmap width; default jaxcelt.sweeps.sweep.DEFAULT_WIDTH)",
-    )
-    p.add_argument("--engine", default="auto", choices=ENGINES, help="how lanes are stepped: auto (the lane kernel on a GPU, the pool elsewhere), pool, or kernel (off a GPU it runs interpreted: for tests, slow)")
-    p.add_argument(
-        "--host-devices",
-        default="auto",
-        help="CPU only: split the CPU into this many JAX devices and shard lanes over them (one XLA CPU "
-        "computation uses about one core); 'auto' = number of CPU cores, 1 = off. Ignored on GPU",
-    )
-    add_host_processes(p)
-    p.add_argument(
-        "--stop-on-invalid",
-        action=argparse.BooleanOptionalAction,
-        default=True,
-        help="end a lane at its first invalid state (lift-off or n3 <= 0; the model does not hold past it): "
-        "label 'invalid', later samples inf, no Lyapunov exponent. --no-stop-on-invalid integrates on",
+    add_sweep_flags(
+        p,
+        lyapunov_default=150,
+        chunk_size_default=200,
+        dtype=False,
+        help={
+            "lyapunov": "periods of tangent dynamics for the Lyapunov exponent (0: off); labels need a long window "
+            "(the exponent's standard error shrinks roughly as 1/sqrt(periods))",
+            "set": "override any CeltParams field, repeatable",
+            "solver": "explicit Runge-Kutta method (adaptive, PID control, section times hit exactly). Dopri8 is "
+            "the same 8th-order Dormand-Prince family as scipy's DOP853: at rtol 1e-8 about 25x more accurate "
+            "than Tsit5, as fast per sweep, but it compiles longer",
+            "chunk-size": "lanes per jitted pool launch (the unit of resumable writing); split over the devices",
+            "width": "pool slots per device: lanes stepped side by side (vmap width; default "
+            "jaxcelt.ensemble.DEFAULT_WIDTH)",
+            "host-devices": "CPU only: split the CPU into this many JAX devices and shard lanes over them (one XLA "
+            "CPU computation uses about one core); 'auto' = number of CPU cores, 1 = off. Ignored on GPU",
+            "stop-on-invalid": "end a lane at its first invalid state (lift-off or n3 <= 0; the model does not hold "
+            "past it): label 'invalid', later samples inf, no Lyapunov exponent. --no-stop-on-invalid integrates on",
+        },
     )
     p.add_argument(
         "--orbits",
@@ -112,56 +66,6 @@ def register(sub) -> None:
     p.add_argument("--out", type=Path, default=Path("out/bifurcation"), help="output directory (resumable)")
     p.add_argument("--no-figures", action="store_true")
     p.set_defaults(func=run)
-
-
-def _ranges(ds, key: str = "regime") -> list[dict]:
-    """Contiguous runs of equal (regime label, global motion) along the swept axis."""
-    import numpy as np
-
-    from jaxcelt.sweeps.regimes import GLOBAL_MOTION, regime_names
-
-    name = ds.attrs["swept_parameter"]
-    vals = ds[name].values
-    reg = ds["regime"].values
-    per = ds["period"].values
-    glob = ds["global_motion"].values
-    if reg.ndim == 2:  # multi-start: first start
-        reg, per, glob = reg[:, 0], per[:, 0], glob[:, 0]
-    labels = [f"{n}, {GLOBAL_MOTION[int(g)]}" for n, g in zip(regime_names(reg, per), glob)]
-    out = []
-    start = 0
-    for i in range(1, len(vals) + 1):
-        if i == len(vals) or labels[i] != labels[start]:
-            out.append({"from": float(vals[start]), "to": float(vals[i - 1]), "n": i - start, "label": labels[start]})
-            start = i
-    lam = ds["lyapunov"].values
-    if np.isfinite(lam).any():
-        out.append({"lyapunov_range_per_s": [float(np.nanmin(lam)), float(np.nanmax(lam))]})
-    return out
-
-
-def regime_ranges(ds) -> list[tuple[float, float, int, str]]:
-    """Contiguous runs of lanes with the same label along the swept axis: ``(from, to, lanes, label)``.
-
-    The label is the local regime with the global motion of O (``"period-1, bounded"``), or
-    ``"invalid"`` for a lane that left the model's validity (its global motion is unknown).
-    A multi-start dataset is labelled by its first start."""
-    from jaxcelt.sweeps.regimes import GLOBAL_MOTION, regime_names
-
-    vals = ds[ds.attrs["swept_parameter"]].values
-    reg, per, glob = ds["regime"].values, ds["period"].values, ds["global_motion"].values
-    if reg.ndim == 2:
-        reg, per, glob = reg[:, 0], per[:, 0], glob[:, 0]
-    labels = [
-        n if g == -1 and n in ("invalid", "failed") else f"{n}, {GLOBAL_MOTION[int(g)]}"
-        for n, g in zip(regime_names(reg, per), glob)
-    ]
-    out, start = [], 0
-    for i in range(1, len(vals) + 1):
-        if i == len(vals) or labels[i] != labels[start]:
-            out.append((float(vals[start]), float(vals[i - 1]), i - start, labels[start]))
-            start = i
-    return out
 
 
 def format_summary(ds, *, wall_seconds: float, out: Path, files: list[str], max_ranges: int = 30) -> str:
@@ -184,6 +88,8 @@ def format_summary(ds, *, wall_seconds: float, out: Path, files: list[str], max_
         f"{cfg.get('solver', '?')} rtol {cfg.get('rtol', '?')}; sweep {wall_seconds:.1f} s including compilation",
         f"regimes by {name}{' [rad/s]' if unit else ''}:",
     ]
+    from jaxcelt.sweeps.regimes import regime_ranges
+
     ranges = regime_ranges(ds)
     for a, b, k, label in ranges[:max_ranges]:
         span = f"{a:8.3f}" if k == 1 else f"{a:8.3f} .. {b:.3f}"
@@ -219,78 +125,6 @@ def format_summary(ds, *, wall_seconds: float, out: Path, files: list[str], max_
     return "\n".join(lines)
 
 
-def add_host_processes(p) -> None:
-    p.add_argument(
-        "--host-processes",
-        default=None,
-        help="CPU only: run the lanes in this many worker processes, each pinned to a core with one JAX device "
-        "('auto' = number of CPU cores; default: off, one process with --host-devices). The workers share no "
-        "thread pool; each compiles its own programs. Replaces --host-devices",
-    )
-
-
-def lane_devices(args):
-    """The sweep's ``devices``: a `jaxcelt.HostProcesses` with --host-processes (this process then keeps
-    one JAX device), else None (all local devices, as --host-devices split the CPU)."""
-    if args.host_processes is None:
-        _set_host_devices(args.host_devices)
-        return None
-    spec = args.host_processes
-    try:
-        n = spec if spec == "auto" else int(spec)
-    except ValueError:
-        n = 0
-    if n != "auto" and n < 1:
-        raise UsageError(f"argument --host-processes: must be an integer >= 1 or 'auto', got {spec!r}")
-    if getattr(args, "engine", "auto") == "kernel":
-        raise UsageError("argument --engine: 'kernel' steps lanes on a GPU; --host-processes starts CPU workers")
-    _set_host_devices("1")
-    from jaxcelt.ensemble import HostProcesses
-
-    return HostProcesses(n)
-
-
-def _set_host_devices(spec: str) -> int:
-    """Ask JAX for ``spec`` CPU devices (before the backend starts); returns the count asked for."""
-    import os
-
-    import jax
-
-    try:
-        n = (os.cpu_count() or 1) if spec == "auto" else int(spec)
-    except ValueError:
-        n = 0
-    if n < 1:
-        raise UsageError(f"argument --host-devices: must be an integer >= 1 or 'auto', got {spec!r}")
-    try:
-        jax.config.update("jax_num_cpu_devices", n)
-    except RuntimeError:  # backend already started (e.g. called from Python after JAX work)
-        pass
-    return n
-
-
-def run_settings(args, wall: float, devices=None) -> dict:
-    """The settings and wall time of a sweep command (``bifurcation``, ``map``) for its summary.json."""
-    import jax
-
-    from jaxcelt.sweeps.sweep import DEFAULT_WIDTH
-
-    return {
-        "transient_periods": args.transient,
-        "sample_periods": args.sample,
-        "lyapunov_periods": args.lyapunov,
-        "solver": args.solver,
-        "rtol": args.rtol,
-        "atol": args.atol,
-        "stop_on_invalid": bool(args.stop_on_invalid),
-        "devices": [str(d) for d in jax.local_devices()] if devices is None else repr(devices),
-        "chunk_size": args.chunk_size,
-        "width_per_device": args.width or DEFAULT_WIDTH,
-        "engine": args.engine,
-        "wall_seconds_including_compile": round(wall, 2),
-    }
-
-
 def run(args) -> int:
     devices = lane_devices(args)
     import numpy as np
@@ -298,8 +132,9 @@ def run(args) -> int:
     import jaxcelt as jc
     from jaxcelt.commands._warnings import one_line_warnings
     from jaxcelt.integrate.solvers import make_solver
+    from jaxcelt.sweeps.api import sweep
     from jaxcelt.sweeps.dataset import open_sweep
-    from jaxcelt.sweeps.sweep import sweep
+    from jaxcelt.sweeps.regimes import regime_runs
     from jaxcelt.versions import versions_string
 
     # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2), before any work
@@ -322,10 +157,10 @@ def run(args) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     solver = make_solver(args.solver)
     if _phase_plots(args):  # the phase plots' program: traced and compiled while the sweep leaves a core idle
-        from jaxcelt.sweeps.sweep import prepare_orbit
+        from jaxcelt.sweeps.dense import prepare_dense_trajectory
 
         pw = params.replace(omega_pi=float(args.orbits[0]))
-        prepare_orbit(pw, jc.initial_state(pw, omega=omega0), **_orbit_settings(args, solver), defer=True)
+        prepare_dense_trajectory(pw, jc.initial_state(pw, omega=omega0), **_orbit_settings(args, solver), defer=True)
     t0 = time.perf_counter()
     with one_line_warnings("bifurcation"):  # e.g. a damaged chunk file recomputed on resume
         sweep(
@@ -360,7 +195,7 @@ def run(args) -> int:
         **run_settings(args, wall, devices),
         "lanes_failed": int(np.sum(np.isin(ds["status"].values, (1, 3)))),  # status 2 = stopped invalid
         "lanes_invalid": int(np.sum(ds["valid"].values == 0)),
-        "regimes": _ranges(ds),
+        "regimes": regime_runs(ds),
     }
     (args.out / "summary.json").write_text(json.dumps(summary, indent=1))
     if not args.no_figures:
@@ -383,7 +218,7 @@ def _figures(args, ds, params, omega0, solver) -> None:
     import numpy as np
 
     import jaxcelt as jc
-    from jaxcelt.sweeps.sweep import orbit, prepare_orbit
+    from jaxcelt.sweeps.dense import dense_trajectory, prepare_dense_trajectory
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -394,7 +229,7 @@ def _figures(args, ds, params, omega0, solver) -> None:
     orbit_settings = _orbit_settings(args, solver)
     if phase_plots:  # compiling on a worker thread (started now if the sweep did not) while the diagrams are drawn
         pw = params.replace(omega_pi=float(args.orbits[0]))
-        prepare_orbit(pw, jc.initial_state(pw, omega=omega0), **orbit_settings)
+        prepare_dense_trajectory(pw, jc.initial_state(pw, omega=omega0), **orbit_settings)
     fig = bifurcation_figure(ds, color_by="regime")
     fig.savefig(args.out / "bifurcation_regime.png", dpi=150)
     plt.close(fig)
@@ -405,7 +240,7 @@ def _figures(args, ds, params, omega0, solver) -> None:
     if phase_plots:
         for w in args.orbits:
             pw = params.replace(omega_pi=float(w))
-            o = orbit(pw, jc.initial_state(pw, omega=omega0), **orbit_settings)
+            o = dense_trajectory(pw, jc.initial_state(pw, omega=omega0), **orbit_settings)
             label = "" if o["valid"] else "model left its validity (lift-off or n3 <= 0)"
             fig = orbit_figure(o["ts"], o["ys"], o["r_O"], o["section_index"], omega_pi=float(w), label=label)
             fig.savefig(args.out / f"orbit_omega{w:g}.png", dpi=130)

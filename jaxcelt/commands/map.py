@@ -15,17 +15,8 @@ import os
 import time
 from pathlib import Path
 
-from jaxcelt.commands.args import (
-    UsageError,
-    floats,
-    nonnegative_int,
-    override,
-    overrides,
-    positive_float,
-    positive_int,
-    value_range,
-)
-from jaxcelt.commands.bifurcation import ENGINES, SWEEP_SOLVERS, add_host_processes, lane_devices, run_settings
+from jaxcelt.commands._sweep_flags import add_sweep_flags, lane_devices, run_settings
+from jaxcelt.commands.args import UsageError, overrides, value_range
 
 
 def register(sub) -> None:
@@ -38,32 +29,21 @@ def register(sub) -> None:
     p.add_argument("--x", default="omega_pi=10:20:40", metavar="NAME=RANGE",
                    help="horizontal axis: a CeltParams field and its values, START:STOP:COUNT or a,b,c")  # fmt: skip
     p.add_argument("--y", default="q_pi=0.02:0.06:24", metavar="NAME=RANGE", help="vertical axis, as --x")
-    p.add_argument("--transient", type=nonnegative_int, default=100, help="transient forcing periods discarded")
-    p.add_argument("--sample", type=positive_int, default=30, help="stroboscopic samples (periods) kept")
-    p.add_argument(
-        "--lyapunov", type=nonnegative_int, default=30, help="periods of tangent dynamics for lambda_1 (0: off)"
+    add_sweep_flags(
+        p,
+        lyapunov_default=30,
+        chunk_size_default=600,
+        dtype=True,
+        help={
+            "lyapunov": "periods of tangent dynamics for lambda_1 (0: off)",
+            "set": "override any other CeltParams field, repeatable",
+            "solver": "explicit Runge-Kutta method",
+            "chunk-size": "lanes per jitted pool launch (unit of resumable writing)",
+            "width": "pool slots per device (default jaxcelt.ensemble.DEFAULT_WIDTH)",
+            "host-devices": "CPU only: split the CPU into this many JAX devices ('auto' = cores, 1 = off)",
+            "stop-on-invalid": "end a lane at its first invalid state (lift-off or n3 <= 0): label 'invalid'",
+        },
     )
-    p.add_argument("--set", action="append", type=override, default=[], metavar="NAME=VALUE",
-                   help="override any other CeltParams field, repeatable")  # fmt: skip
-    p.add_argument("--omega0", type=floats(3), default="0,0,0", help="initial omega (body) [rad/s]")
-    p.add_argument("--solver", default="Tsit5", choices=SWEEP_SOLVERS, help="explicit Runge-Kutta method")
-    p.add_argument("--rtol", type=positive_float, default=1e-8)
-    p.add_argument("--atol", type=positive_float, default=1e-10)
-    p.add_argument("--max-steps", type=positive_int, default=1_000_000)
-    p.add_argument("--dtype", default="float64", choices=("float64", "float32"),
-                   help="the pool's arithmetic (float32: faster on GPUs; use --rtol >= 1e-6)")  # fmt: skip
-    p.add_argument(
-        "--chunk-size", type=positive_int, default=600, help="lanes per jitted pool launch (unit of resumable writing)"
-    )
-    p.add_argument(
-        "--width", type=positive_int, default=None, help="pool slots per device (default jaxcelt.sweeps.sweep.DEFAULT_WIDTH)"
-    )
-    p.add_argument("--engine", default="auto", choices=ENGINES, help="how lanes are stepped: auto (the lane kernel on a GPU, the pool elsewhere), pool, or kernel (off a GPU it runs interpreted: for tests, slow)")
-    p.add_argument("--host-devices", default="auto",
-                   help="CPU only: split the CPU into this many JAX devices ('auto' = cores, 1 = off)")  # fmt: skip
-    add_host_processes(p)
-    p.add_argument("--stop-on-invalid", action=argparse.BooleanOptionalAction, default=True,
-                   help="end a lane at its first invalid state (lift-off or n3 <= 0): label 'invalid'")  # fmt: skip
     p.add_argument("--out", type=Path, default=Path("out/map"), help="output directory (resumable)")
     p.add_argument("--no-figures", action="store_true")
     p.set_defaults(func=run)

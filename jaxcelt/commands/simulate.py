@@ -7,7 +7,7 @@ import json
 import time
 from pathlib import Path
 
-from jaxcelt.commands.args import finite_float, floats, override, overrides, positive_float, positive_int
+from jaxcelt.commands.args import add_set_flag, finite_float, floats, overrides, positive_float, positive_int
 
 
 def register(sub) -> None:
@@ -24,14 +24,7 @@ def register(sub) -> None:
     p.add_argument("--omega0", type=floats(3), default=[0.0, 0.0, 0.0], help="initial omega (body) [rad/s], 'w1,w2,w3'")
     p.add_argument("--n0", type=floats(3), default=[0.0, 0.0, 1.0], help="initial vertical in body axes (normalised)")
     p.add_argument("--psi0", type=finite_float, default=0.0, help="initial heading psi [rad]")
-    p.add_argument(
-        "--set",
-        action="append",
-        type=override,
-        default=[],
-        metavar="NAME=VALUE",
-        help="override any CeltParams field, repeatable",
-    )
+    add_set_flag(p)
     p.add_argument("--rtol", type=positive_float, default=1e-8)
     p.add_argument("--atol", type=positive_float, default=1e-10)
     p.add_argument("--stop-on-invalid", action="store_true", help="stop at lift-off or n3 <= 0")

@@ -6,17 +6,23 @@
 * `pool`: `run_pool`, lanes through a fixed number of refilled batch slots in one jitted
   while loop, with `PoolStats`;
 * `shard`: lanes over devices;
+* `runners`: `AbstractLaneRunner`, the interface of whatever runs a chunk off this process's devices;
 * `processes`: `HostProcesses`, lanes over single-device worker processes, one per CPU core;
 * `kernel`: the lane kernel, every lane of a chunk stepped inside one GPU kernel, one thread
   per lane (Pallas, Triton backend), with the field re-expressed on lane blocks by `soa`;
-* `stroboscopic`: `run_lanes`, one chunk of lanes sampled at the forcing's section times
-  (`SweepConfig`), sharded over devices, through the pool or the kernel (`ENGINES`), with the
-  optional Lyapunov stage.
+* `config`: `SweepConfig`, the settings of a stroboscopic chunk, and the engines (`ENGINES`);
+* `stroboscopic`: `run_lanes`, one chunk of lanes sampled at the forcing's section times,
+  sharded over devices, through the pool or the kernel (`ENGINES`), with the optional Lyapunov
+  stage.
 
-The user-facing sweeps (`jaxcelt.sweeps.sweep`: `bifurcation`, `parameter_map`, ...) are built on it.
+The user-facing sweeps (`jaxcelt.sweeps`: `bifurcation`, `parameter_map`, ...) are built on it; the engine
+imports nothing of them (nor of `jaxcelt.orbits` or `jaxcelt.identify`).
 The diffrax internals it mirrors live in `jaxcelt._diffrax_adapter`.
 """
 
+from jaxcelt.ensemble.config import ENGINES as ENGINES
+from jaxcelt.ensemble.config import SweepConfig as SweepConfig
+from jaxcelt.ensemble.config import check_engine as check_engine
 from jaxcelt.ensemble.kernel import BLOCK as BLOCK
 from jaxcelt.ensemble.kernel import kernel_supported as kernel_supported
 from jaxcelt.ensemble.lanes import LaneMonitor as LaneMonitor
@@ -32,6 +38,7 @@ from jaxcelt.ensemble.pool import run_pool as run_pool
 from jaxcelt.ensemble.pool import split_lane_args as split_lane_args
 from jaxcelt.ensemble.pool import start_lanes as start_lanes
 from jaxcelt.ensemble.processes import HostProcesses as HostProcesses
+from jaxcelt.ensemble.runners import AbstractLaneRunner as AbstractLaneRunner
 from jaxcelt.ensemble.shard import device_mesh as device_mesh
 from jaxcelt.ensemble.shard import pad_lanes as pad_lanes
 from jaxcelt.ensemble.shard import shard_lanes as shard_lanes
@@ -44,8 +51,6 @@ from jaxcelt.ensemble.stepper import FusedStepState as FusedStepState
 from jaxcelt.ensemble.stepper import erk_tableau as erk_tableau
 from jaxcelt.ensemble.stepper import kernel_boundary as kernel_boundary
 from jaxcelt.ensemble.stepper import make_stepper as make_stepper
-from jaxcelt.ensemble.stroboscopic import ENGINES as ENGINES
-from jaxcelt.ensemble.stroboscopic import SweepConfig as SweepConfig
 from jaxcelt.ensemble.stroboscopic import lanes_params as lanes_params
 from jaxcelt.ensemble.stroboscopic import run_lanes as run_lanes
-from jaxcelt.ensemble.stroboscopic import run_lanes_with_stats as run_lanes_with_stats
+from jaxcelt.ensemble.stroboscopic import run_lanes_with_stats as run_lanes_with_stats  # deprecated

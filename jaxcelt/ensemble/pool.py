@@ -80,7 +80,7 @@ predicted remaining cost (``benchmarks/bench_schedule.py``)"""
 
 class PoolStats(eqx.Module):
     """How a pool ran. Inside the jitted pool: int32 counters of one device; from
-    `jaxcelt.sweeps.sweep.run_lanes`: plain ints over all devices."""
+    `jaxcelt.ensemble.run_lanes`: plain ints over all devices."""
 
     iterations: Any
     """loop iterations (every iteration steps every slot once); over devices: the busiest one's"""

@@ -10,8 +10,9 @@ three quarters of the one-process time in 2 pinned processes, and varied less; w
 18.1 s in one process, and stopping lanes at invalid states 3.57 s against 3.69 s
 (``benchmarks/bench_processes.py`` -> docs/bifurcation/processes.json).
 
-`HostProcesses` is accepted wherever a sweep takes ``devices`` (`jaxcelt.sweeps.sweep.sweep`,
-``bifurcation``, ``parameter_map``, `jaxcelt.sweeps.sweep.run_lanes`): each chunk's lanes are dealt
+`HostProcesses` (an `jaxcelt.ensemble.runners.AbstractLaneRunner`) is accepted wherever a sweep takes
+``devices`` (`jaxcelt.sweeps.api.sweep`, ``bifurcation``, ``parameter_map``, `jaxcelt.ensemble.run_lanes`):
+each chunk's lanes are dealt
 round-robin to the workers (lane i to worker i mod n, as lanes are dealt to devices), each
 worker runs them through its own lane pool on its one core, and the results are put back in
 lane order. The workers are started at the first chunk and kept for the next ones (each
@@ -38,6 +39,8 @@ import jax
 import numpy as np
 
 from jaxcelt.ensemble.pool import PoolStats
+from jaxcelt.ensemble.runners import AbstractLaneRunner
+from jaxcelt.ensemble.stroboscopic import run_lanes, varying_names
 
 __all__ = ["HostProcesses"]
 
@@ -52,13 +55,7 @@ _SETTINGS = (
 
 def _worker_main() -> None:
     """A worker's main loop (started by `HostProcesses`, pinned and configured by its environment):
-    (args, kwargs) of `run_lanes_with_stats` in, results out."""
-    from multiprocessing.connection import Connection
-
-    import jax
-
-    from jaxcelt.ensemble.stroboscopic import run_lanes_with_stats
-
+    (args, kwargs) of `jaxcelt.ensemble.run_lanes` in, results and statistics out."""
     conn = Connection(int(os.environ["JAXCELT_WORKER_FD"]))
     device = jax.local_devices()[:1]
     while True:
@@ -70,7 +67,7 @@ def _worker_main() -> None:
             return
         args, kwargs = msg
         try:
-            out, st = run_lanes_with_stats(*args, devices=device, **kwargs)
+            out, st = run_lanes(*args, devices=device, stats=True, **kwargs)
             conn.send(("ok", out, (int(st.iterations), int(st.slot_steps), int(st.width))))
         except Exception as e:  # reported to the parent, which raises it there
             conn.send(("error", type(e).__name__, str(e), traceback.format_exc()))
@@ -104,7 +101,7 @@ def _stop(workers: list[tuple[Any, Any]]) -> None:
     workers.clear()
 
 
-class HostProcesses:
+class HostProcesses(AbstractLaneRunner):
     """``n`` single-device worker processes, one pinned to each of ``n`` CPU cores: pass as
     ``devices`` to a sweep (see the module docstring for when this pays).
 
@@ -162,11 +159,19 @@ class HostProcesses:
             self._workers.append((Connection(here.detach()), proc))
 
     def run(
-        self, pb: Any, y0b: Any, cfg: Any, *, pad_to: int | None, varying: tuple[str, ...], **kwargs: Any
+        self,
+        pb: Any,
+        y0b: Any,
+        cfg: Any,
+        *,
+        pad_to: int | None,
+        varying: tuple[str, ...],
+        engine: str = "auto",
+        **kwargs: Any,
     ) -> tuple[dict[str, np.ndarray], PoolStats]:
-        """`jaxcelt.ensemble.run_lanes_with_stats` over the workers (lanes dealt round-robin)."""
-        from jaxcelt.ensemble.stroboscopic import varying_names
-
+        """`jaxcelt.ensemble.run_lanes` (``stats=True``) over the workers (lanes dealt round-robin)."""
+        if engine == "kernel":
+            raise ValueError("engine='kernel' steps lanes on a GPU; HostProcesses are CPU worker processes (use the pool)")
         pb = jax.tree_util.tree_map(np.asarray, pb)
         y0b = np.asarray(y0b, dtype=np.float64)
         L = int(y0b.shape[0])
@@ -182,7 +187,7 @@ class HostProcesses:
                 continue
             send = idx if len(idx) else np.arange(min(1, L))  # compile_only: any lane (all count as padding)
             sub = jax.tree_util.tree_map(lambda x, s=send: x[s], pb)
-            conn.send(((sub, y0b[send], cfg), dict(kwargs, pad_to=per, varying=varying)))
+            conn.send(((sub, y0b[send], cfg), dict(kwargs, pad_to=per, varying=varying, engine=engine)))
             jobs.append((idx, conn))
         outs, stats, error = [], [], None
         for idx, conn in jobs:

@@ -4,8 +4,9 @@ For a lane with forcing frequency omega_pi the section times are t0 + (transient
 omega_pi, k = 0 .. S-1 (`SweepConfig`); the stepper steps exactly onto them, so the samples are
 solver states. `run_lanes` runs one chunk of lanes: padded and dealt round-robin over the
 devices (`jaxcelt.ensemble.shard`), through the pool (`jaxcelt.ensemble.pool`) in one jitted
-call per device, then the optional Lyapunov stage. Chunking, resumable writing and several
-processes are `jaxcelt.sweeps.sweep`'s business.
+call per device, then the optional Lyapunov stage; or hands the chunk to an
+`jaxcelt.ensemble.runners.AbstractLaneRunner` (worker processes). Chunking, resumable writing and
+several processes of a distributed run are `jaxcelt.sweeps.driver`'s business.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
@@ -25,6 +27,7 @@ from jaxcelt import _config  # noqa: F401
 from jaxcelt._compile_options import compiler_options, is_wide_pool, pool_compiler_options
 from jaxcelt._executable_cache import compile_later, gc_paused, start_deferred
 from jaxcelt._types import Array
+from jaxcelt.ensemble.config import ENGINES, SweepConfig, check_engine
 from jaxcelt.ensemble.kernel import BLOCK, kernel_supported, make_segment, run_kernel_lanes
 from jaxcelt.ensemble.pool import (
     DEFAULT_WIDTH,
@@ -37,76 +40,15 @@ from jaxcelt.ensemble.pool import (
     split_lane_args,
     start_lanes,
 )
+from jaxcelt.ensemble.runners import AbstractLaneRunner
 from jaxcelt.ensemble.shard import device_mesh, pad_lanes, shard_lanes
 from jaxcelt.ensemble.stepper import AbstractLaneStepper, FusedERKStepper, erk_tableau, float64_times, make_stepper
 from jaxcelt.integrate.lyapunov import celt_lyapunov
-from jaxcelt.integrate.solve import DEFAULT_SOLVER
 from jaxcelt.physics.contact.registry import get_contact_law
 from jaxcelt.physics.diagnostics import centre_position
 from jaxcelt.physics.params import PARAM_NAMES, CeltParams
 
-__all__ = ["SweepConfig", "lanes_params", "run_lanes", "run_lanes_with_stats", "ENGINES"]
-
-ENGINES = ("auto", "pool", "kernel")
-"""how lanes are stepped: ``"pool"`` (`jaxcelt.ensemble.pool`, any solver, any device),
-``"kernel"`` (`jaxcelt.ensemble.kernel`, explicit FSAL solvers; compiled for a GPU, interpreted
-elsewhere) or ``"auto"``: the kernel on a GPU where the solver allows it, else the pool"""
-
-
-@dataclasses.dataclass(frozen=True)
-class SweepConfig:
-    """Static settings of a sweep (everything but the parameter values and initial states)."""
-
-    transient_periods: int = 200
-    sample_periods: int = 100
-    lyapunov_periods: int = 0
-    """periods of tangent dynamics after the transient (0: no Lyapunov exponent)"""
-    rtol: float = 1e-8
-    atol: float = 1e-10
-    max_steps: int = 1_000_000
-    solver: Any = DEFAULT_SOLVER
-    contact_law: Any = None
-    t0: float = 0.0
-    stop_on_invalid: bool = False
-    """end a lane at the first accepted step whose end state is invalid (status 2, later samples inf)"""
-    dtype: str = "float64"
-    """"float64" (default) or "float32": the lanes' arithmetic (times stay float64 with an explicit FSAL
-    solver, `jaxcelt.ensemble.float64_times`; the Lyapunov stage stays float64)"""
-
-    def __post_init__(self):
-        if self.dtype not in ("float64", "float32"):
-            raise ValueError(f"'dtype' must be 'float64' or 'float32', got {self.dtype!r}")
-        for name in ("transient_periods", "sample_periods", "lyapunov_periods", "max_steps"):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < 0:
-                raise ValueError(f"{name!r} must be a non-negative int, got {v!r}")
-        if self.sample_periods < 1:
-            raise ValueError(f"'sample_periods' must be >= 1, got {self.sample_periods}")
-        if self.max_steps < 1:
-            raise ValueError(f"'max_steps' must be >= 1, got {self.max_steps}")
-        for name in ("rtol", "atol"):
-            v = getattr(self, name)
-            if not (np.isfinite(v) and v > 0):
-                raise ValueError(f"{name!r} must be a positive finite number, got {v!r}")
-
-    def attrs(self) -> dict[str, Any]:
-        """Plain-python description (for dataset attributes)."""
-        law = get_contact_law(self.contact_law)
-        return dict(
-            transient_periods=int(self.transient_periods),
-            sample_periods=int(self.sample_periods),
-            lyapunov_periods=int(self.lyapunov_periods),
-            rtol=float(self.rtol),
-            atol=float(self.atol),
-            max_steps=int(self.max_steps),
-            solver=type(self.solver).__name__,
-            step_size_controller="PIDController + ClipStepSizeController(step_ts=section times)",
-            contact_law=f"{type(law).__name__}(rolling_resistance={law.rolling_resistance})",
-            t0=float(self.t0),
-            stop_on_invalid=int(bool(self.stop_on_invalid)),
-            dtype=str(self.dtype),
-        )
-
+__all__ = ["SweepConfig", "lanes_params", "run_lanes", "run_lanes_with_stats", "ENGINES", "check_engine"]
 
 def lanes_params(params: CeltParams, name: str, values: Array) -> CeltParams:
     """A batched `CeltParams` with a leading lane axis: field ``name`` = ``values``, others broadcast."""
@@ -267,26 +209,18 @@ _lyap_chunk = {
 }
 
 
-def check_engine(engine: str, solver: Any) -> None:
-    """ValueError unless ``engine`` is one of `ENGINES` and can run ``solver``."""
-    if engine not in ENGINES:
-        raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
-    if engine == "kernel" and not kernel_supported(solver):
-        raise ValueError(f"engine='kernel' needs an explicit FSAL Runge-Kutta solver, got {type(solver).__name__}")
-
-
 def varying_names(pb: CeltParams) -> set[str]:
     """Names of the parameters whose values differ between the lanes of ``pb`` (leading lane axis)."""
     leaves = jax.tree_util.tree_flatten_with_path(pb)[0]
     return {path[-1].name for path, x in leaves if np.any(np.asarray(x) != np.asarray(x)[:1])}
 
 
-def run_lanes_with_stats(
+def run_lanes(
     pb: CeltParams,
     y0b: Array,
     cfg: SweepConfig,
     *,
-    devices: Sequence[Any] | None = None,
+    devices: Sequence[Any] | AbstractLaneRunner | None = None,
     pad_to: int | None = None,
     width: int | None = None,
     compile_only: bool = False,
@@ -295,23 +229,83 @@ def run_lanes_with_stats(
     drain_factor: int = DRAIN_FACTOR,
     min_drain_width: int = MIN_DRAIN_WIDTH,
     engine: str = "auto",
+    stats: bool = False,
+) -> dict[str, np.ndarray] | tuple[dict[str, np.ndarray], PoolStats]:
+    """Run one chunk of lanes (batched params and y0 with a leading lane axis) and return numpy arrays.
+
+    ``width`` batch slots per device (default `DEFAULT_WIDTH`) step in one jitted while loop
+    (`jaxcelt.ensemble.run_pool`); a slot whose lane finishes is refilled with the next lane at
+    once, so no slot idles until the slowest lane is done (only the final drain does).
+    ``pilot_fraction`` (default `PILOT_FRACTION`; 0 = off; only used when a device has more
+    lanes than slots): each lane pauses once after this fraction of its time span and is taken
+    up again costliest-predicted first. ``drain_factor``, ``min_drain_width``: the pool's drain
+    schedule (`jaxcelt.ensemble.pool`). The Lyapunov stage (``cfg.lyapunov_periods > 0``) then
+    runs vmapped over the successful lanes in groups of the pool's width ordered by the measured
+    main-solve step count (a cost estimate that needs no pilot run).
+
+    Sharded over ``devices`` (default all local devices; lanes are dealt round-robin); padded
+    to ``pad_to`` lanes (so a short last chunk reuses the compiled shape) and to a multiple
+    of the device count. Padding lanes are dropped; in the pool they finish at once.
+    ``devices`` may be an `jaxcelt.ensemble.runners.AbstractLaneRunner` (e.g.
+    `jaxcelt.ensemble.HostProcesses`: the lanes then run in its worker processes, one per CPU core).
+    ``engine``: `ENGINES` (the kernel's `PoolStats` count its loop iterations, one per step of its
+    slowest lane, with ``width`` = `BLOCK`).
+    ``compile_only=True``: every lane marked as padding -- compiles the kernel for these
+    shapes and returns at once (used to time compilation apart from running).
+    ``varying``: names of parameters to treat as differing between lanes even where this
+    chunk's lanes happen to share a value (parameters that do differ are always detected),
+    so that all chunks of a sweep compile to one kernel; the others are constants of the
+    pool's step.
+
+    Returns the fields of `jaxcelt.sweeps.result.SweepResult` but ``values`` (lane axis first). With
+    ``stats=False`` (default) the pool's statistics are copied into every lane: ``pool_iterations``
+    (the busiest device's loop iterations), ``pool_slot_steps`` (step slots paid over all devices),
+    ``pool_width``; with ``stats=True`` they come apart: ``(lanes, PoolStats)``.
+    """
+    out, st = _run_lanes(
+        pb, y0b, cfg, devices=devices, pad_to=pad_to, width=width, compile_only=compile_only, varying=varying,
+        pilot_fraction=pilot_fraction, drain_factor=drain_factor, min_drain_width=min_drain_width, engine=engine,
+    )  # fmt: skip
+    if stats:
+        return out, st
+    L = len(out["status"])
+    out["pool_iterations"] = np.full(L, st.iterations)
+    out["pool_slot_steps"] = np.full(L, st.slot_steps)
+    out["pool_width"] = np.full(L, st.width)
+    return out
+
+
+def run_lanes_with_stats(*args: Any, **kwargs: Any) -> tuple[dict[str, np.ndarray], PoolStats]:
+    """Deprecated: ``run_lanes(..., stats=True)``."""
+    warnings.warn(
+        "run_lanes_with_stats is deprecated and will be removed in the next release; use run_lanes(..., stats=True)",
+        DeprecationWarning,
+        stacklevel=2,
+    )
+    return run_lanes(*args, stats=True, **kwargs)
+
+
+def _run_lanes(
+    pb: CeltParams,
+    y0b: Array,
+    cfg: SweepConfig,
+    *,
+    devices: Sequence[Any] | AbstractLaneRunner | None,
+    pad_to: int | None,
+    width: int | None,
+    compile_only: bool,
+    varying: Sequence[str],
+    pilot_fraction: float,
+    drain_factor: int,
+    min_drain_width: int,
+    engine: str,
 ) -> tuple[dict[str, np.ndarray], PoolStats]:
-    """`run_lanes`, with the pool's statistics apart: (per-lane numpy arrays, `PoolStats` over
-    all devices: the busiest device's iterations, the step slots paid by all, the width).
-    ``drain_factor``, ``min_drain_width``: the pool's drain schedule (`jaxcelt.ensemble.pool`).
-    ``devices`` may be a `jaxcelt.ensemble.HostProcesses`: the lanes then run in its worker
-    processes, one per CPU core. ``engine``: `ENGINES` (the kernel's `PoolStats` count its loop
-    iterations, one per step of its slowest lane, with ``width`` = `BLOCK`)."""
-    from jaxcelt.ensemble.processes import HostProcesses
-
+    """`run_lanes` with the statistics apart (its body)."""
     check_engine(engine, cfg.solver)
-
-    if isinstance(devices, HostProcesses):
-        if engine == "kernel":
-            raise ValueError("engine='kernel' steps lanes on a GPU; HostProcesses are CPU worker processes (use the pool)")
+    if isinstance(devices, AbstractLaneRunner):  # the whole chunk runs elsewhere (e.g. worker processes)
         kw = dict(width=width, compile_only=compile_only, pilot_fraction=pilot_fraction)
         kw.update(drain_factor=drain_factor, min_drain_width=min_drain_width)
-        return devices.run(pb, y0b, cfg, pad_to=pad_to, varying=tuple(varying), **kw)
+        return devices.run(pb, y0b, cfg, pad_to=pad_to, varying=tuple(varying), engine=engine, **kw)
     mesh = device_mesh(devices)
     L = int(np.shape(y0b)[0])
     ndev = 1 if mesh is None else mesh.devices.size
@@ -414,52 +408,3 @@ def run_lanes_with_stats(
             out["lyapunov"][idx[:n]] = np.asarray(lam)[:n]
             out["lyapunov_stderr"][idx[:n]] = np.asarray(err)[:n]
     return out, stats
-
-
-def run_lanes(
-    pb: CeltParams,
-    y0b: Array,
-    cfg: SweepConfig,
-    *,
-    devices: Sequence[Any] | None = None,
-    pad_to: int | None = None,
-    width: int | None = None,
-    compile_only: bool = False,
-    varying: Sequence[str] = (),
-    pilot_fraction: float = PILOT_FRACTION,
-    engine: str = "auto",
-) -> dict[str, np.ndarray]:
-    """Run one chunk of lanes (batched params and y0 with a leading lane axis) and return numpy arrays.
-
-    ``width`` batch slots per device (default `DEFAULT_WIDTH`) step in one jitted while loop
-    (`jaxcelt.ensemble.run_pool`); a slot whose lane finishes is refilled with the next lane at
-    once, so no slot idles until the slowest lane is done (only the final drain does).
-    ``pilot_fraction`` (default `PILOT_FRACTION`; 0 = off; only used when a device has more
-    lanes than slots): each lane pauses once after this fraction of its time span and is taken
-    up again costliest-predicted first. The Lyapunov stage (``cfg.lyapunov_periods > 0``) then
-    runs vmapped over the successful lanes in groups of the pool's width ordered by the measured
-    main-solve step count (a cost estimate that needs no pilot run).
-
-    Sharded over ``devices`` (default all local devices; lanes are dealt round-robin); padded
-    to ``pad_to`` lanes (so a short last chunk reuses the compiled shape) and to a multiple
-    of the device count. Padding lanes are dropped; in the pool they finish at once.
-    ``compile_only=True``: every lane marked as padding -- compiles the kernel for these
-    shapes and returns at once (used to time compilation apart from running).
-    ``varying``: names of parameters to treat as differing between lanes even where this
-    chunk's lanes happen to share a value (parameters that do differ are always detected),
-    so that all chunks of a sweep compile to one kernel; the others are constants of the
-    pool's step.
-
-    Returns the fields of `jaxcelt.sweeps.sweep.SweepResult` but ``values`` (lane axis first), and the pool's
-    statistics copied into every lane: ``pool_iterations``, ``pool_slot_steps``,
-    ``pool_width`` (`run_lanes_with_stats` returns them apart, as `PoolStats`).
-    """
-    out, stats = run_lanes_with_stats(
-        pb, y0b, cfg, devices=devices, pad_to=pad_to, width=width, compile_only=compile_only, varying=varying,
-        pilot_fraction=pilot_fraction, engine=engine,
-    )  # fmt: skip
-    L = len(out["status"])
-    out["pool_iterations"] = np.full(L, stats.iterations)  # the busiest device's loop iterations
-    out["pool_slot_steps"] = np.full(L, stats.slot_steps)  # step slots paid, over all devices and widths
-    out["pool_width"] = np.full(L, stats.width)
-    return out

@@ -1,6 +1,6 @@
 """Attractor census of the forced wobblestone: many starts, one forcing frequency, distinct attractors.
 
-Every start state is one lane of `jaxcelt.sweeps.sweep` (same parameters, ``y0`` per lane). After
+Every start state is one lane of `jaxcelt.sweeps.api.sweep` (same parameters, ``y0`` per lane). After
 ``transient_periods`` forcing periods each lane is sampled on the stroboscopic section for
 ``sample_periods`` periods and labelled by `jaxcelt.sweeps.regimes.classify`:
 
@@ -37,8 +37,8 @@ import numpy as np
 
 from jaxcelt.physics.params import CeltParams
 from jaxcelt.physics.state import initial_state
+from jaxcelt.sweeps.api import sweep
 from jaxcelt.sweeps.regimes import REGIMES, classify
-from jaxcelt.sweeps.sweep import sweep
 
 __all__ = [
     "AttractorStarts",
@@ -298,7 +298,7 @@ def attractors(
     refine_options: dict[str, Any] | None = None,
     **sweep_options: Any,
 ) -> AttractorCensus:
-    """Census of the attractors reached from ``starts`` at ``params`` (one `jaxcelt.sweeps.sweep`).
+    """Census of the attractors reached from ``starts`` at ``params`` (one `jaxcelt.sweeps.api.sweep`).
 
     Args:
         params: the stone and the base (a single parameter set).
@@ -311,8 +311,8 @@ def attractors(
         chaos_threshold: [1/s] exponent separating chaotic from quasi-periodic lanes.
         refine: refine each periodic attractor with `jaxcelt.periodic_orbit` (multipliers).
         refine_options: keyword arguments of `periodic_orbit`.
-        sweep_options: further `jaxcelt.sweeps.sweep` options (``lyapunov_periods``, ``rtol``, ``width``,
-            ``chunk_size``, ``out``, ...).
+        sweep_options: further `jaxcelt.sweeps.options.SweepOptions` fields (``lyapunov_periods``, ``rtol``,
+            ``width``, ``chunk_size``, ``out``, ...), or ``options=SweepOptions(...)``.
     """
     if not isinstance(params, CeltParams):
         raise ValueError(f"attractors: 'params' must be a CeltParams, got {type(params).__name__}")

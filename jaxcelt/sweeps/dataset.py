@@ -9,7 +9,7 @@ Layout of an output directory ``out/``::
     out/sweep.nc               the merged dataset, written when every chunk is done
 
 An interrupted sweep (killed process, power cut) is resumed by calling the same
-`jaxcelt.sweeps.sweep`/`bifurcation` with the same ``out``: finished chunks are read back, the
+`jaxcelt.sweeps.api.sweep`/`bifurcation` with the same ``out``: finished chunks are read back, the
 missing ones computed. A chunk file is used only if it opens, belongs to this sweep (its
 fingerprint), holds this chunk's lanes (their indices) and every expected variable with the
 expected shape; a damaged one (torn write, bad copy, a file of another sweep or version) is
@@ -40,6 +40,7 @@ import xarray as xr
 from jaxcelt.physics.model import STATE_NAMES
 from jaxcelt.physics.params import CeltParams
 from jaxcelt.sweeps.regimes import GLOBAL_MOTION, REGIMES, classify
+from jaxcelt.sweeps.result import LANE_DIMS, LANE_FIELDS
 
 __all__ = ["SweepWriter", "to_dataset", "to_map_dataset", "open_sweep", "SWEEP_FILE", "DamagedChunkWarning"]
 
@@ -51,32 +52,6 @@ class DamagedChunkWarning(RuntimeWarning):
     """A chunk file of an interrupted sweep could not be used on resume; the chunk is recomputed."""
 
 
-LANE_FIELDS = (
-    "t_samples",
-    "samples",
-    "y_final",
-    "status",
-    "valid",
-    "first_invalid_t",
-    "first_invalid_kind",
-    "min_N",
-    "max_tilt",
-    "drift",
-    "max_excursion",
-    "num_steps",
-    "lyapunov",
-    "lyapunov_stderr",
-    "r_O",
-)
-"""per-lane arrays of a sweep (the fields of `jaxcelt.sweeps.sweep.SweepResult` but ``values``), in
-dataset order; sweep.py imports this module, not the other way round"""
-
-_LANE_DIMS: dict[str, tuple[str, ...]] = {
-    "t_samples": ("sample",),
-    "samples": ("sample", "state"),
-    "y_final": ("state",),
-    "r_O": ("sample", "xyz"),
-}
 _RENAME = {"samples": "section", "t_samples": "t_section"}
 _DOCS = {
     "section": ("state at the stroboscopic times t0 + (transient + k) 2 pi/omega_pi", "SI (see state)"),
@@ -149,7 +124,7 @@ def _lane_variables(fields: dict[str, Any], lead: tuple[str, ...], **classify_kw
             arr = arr.astype(np.int8)
         out = _RENAME.get(key, key)
         desc, units = _DOCS[out]
-        data[out] = xr.Variable(lead + _LANE_DIMS.get(key, ()), arr, attrs={"long_name": desc, "units": units})
+        data[out] = xr.Variable(lead + LANE_DIMS.get(key, ()), arr, attrs={"long_name": desc, "units": units})
     f = fields
     labels = classify(
         f["samples"], f["status"], f["valid"], f["r_O"], f["lyapunov"], lyapunov_stderr=f["lyapunov_stderr"],
@@ -166,7 +141,7 @@ def _base_coords(n_samples: int) -> dict[str, Any]:
 
 
 def to_dataset(result: Any, params: CeltParams, config: Any, **classify_kwargs) -> xr.Dataset:
-    """An xarray Dataset from a `jaxcelt.sweeps.sweep.SweepResult` (regime labels added)."""
+    """An xarray Dataset from a `jaxcelt.sweeps.result.SweepResult` (regime labels added)."""
     name = result.name
     vals = np.asarray(result.values)
     multi = vals.ndim == 2
@@ -189,7 +164,7 @@ def to_lanes_dataset(
     config: Any,
     **classify_kwargs,
 ) -> xr.Dataset:
-    """A dataset of an arbitrary batch of lanes (`jaxcelt.sweeps.sweep.sweep_lanes`): dim ``lane``, each
+    """A dataset of an arbitrary batch of lanes (`jaxcelt.sweeps.api.sweep_lanes`): dim ``lane``, each
     varied parameter a coordinate along it."""
     n = len(lanes["status"])
     coords: dict[str, Any] = {"lane": np.arange(n), **_base_coords(lanes["samples"].shape[-2])}
@@ -238,7 +213,7 @@ def open_sweep(path: str | os.PathLike) -> xr.Dataset:
 
 
 class SweepWriter:
-    """Chunk-by-chunk writer with resume (used by `jaxcelt.sweeps.sweep` when ``out`` is given)."""
+    """Chunk-by-chunk writer with resume (used by `jaxcelt.sweeps.driver` when ``out`` is given)."""
 
     def __init__(self, out, *, params, name, lane_values, lane_y0, n_starts, config, chunks):
         self.dir = Path(out)
@@ -333,7 +308,7 @@ class SweepWriter:
         return ds
 
 
-_CHUNK_SCALARS = tuple(f for f in LANE_FIELDS if f not in _LANE_DIMS)
+_CHUNK_SCALARS = tuple(f for f in LANE_FIELDS if f not in LANE_DIMS)
 """per-lane scalars every chunk file holds (besides samples, t_samples, r_O, y_final)"""
 
 

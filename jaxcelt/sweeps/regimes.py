@@ -30,13 +30,16 @@ Global label: ``unbounded`` when O's net horizontal displacement over the sample
 ``drift_threshold`` [m] and is at least half of its maximum excursion (steady wandering
 away), else ``bounded``. The thresholds are heuristics; the raw numbers (drift, excursion,
 exponent) are kept beside the labels.
+
+Along the swept axis of a one-parameter sweep dataset, `regime_ranges` and `regime_runs` group
+consecutive lanes with the same label into ranges (the regime table of ``jaxcelt bifurcation``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["REGIMES", "GLOBAL_MOTION", "detect_period", "classify", "regime_names"]
+__all__ = ["REGIMES", "GLOBAL_MOTION", "detect_period", "classify", "regime_names", "regime_ranges", "regime_runs"]
 
 REGIMES: dict[int, str] = {
     0: "failed",
@@ -162,4 +165,52 @@ def regime_names(regime: np.ndarray, period: np.ndarray) -> np.ndarray:
     for idx in np.ndindex(regime.shape):
         r = int(regime[idx])
         out[idx] = f"period-{int(period[idx])}" if r == 2 else REGIMES[r]
+    return out
+
+
+def _first_start(ds) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Swept values and (regime, period, global motion) of a sweep dataset; a multi-start one by its first start."""
+    vals = ds[ds.attrs["swept_parameter"]].values
+    reg, per, glob = ds["regime"].values, ds["period"].values, ds["global_motion"].values
+    if reg.ndim == 2:
+        reg, per, glob = reg[:, 0], per[:, 0], glob[:, 0]
+    return vals, reg, per, glob
+
+
+def _runs(vals: np.ndarray, labels: list[str]) -> list[tuple[float, float, int, str]]:
+    out, start = [], 0
+    for i in range(1, len(vals) + 1):
+        if i == len(vals) or labels[i] != labels[start]:
+            out.append((float(vals[start]), float(vals[i - 1]), i - start, labels[start]))
+            start = i
+    return out
+
+
+def regime_ranges(ds) -> list[tuple[float, float, int, str]]:
+    """Contiguous runs of lanes with the same label along the swept axis: ``(from, to, lanes, label)``.
+
+    ``ds``: a one-parameter sweep dataset (`jaxcelt.sweeps.dataset`). The label is the local regime
+    with the global motion of O (``"period-1, bounded"``), or ``"invalid"``/``"failed"`` alone for a
+    lane whose global motion is unknown. A multi-start dataset is labelled by its first start."""
+    vals, reg, per, glob = _first_start(ds)
+    labels = [
+        n if g == -1 and n in ("invalid", "failed") else f"{n}, {GLOBAL_MOTION[int(g)]}"
+        for n, g in zip(regime_names(reg, per), glob)
+    ]
+    return _runs(vals, labels)
+
+
+def regime_runs(ds) -> list[dict]:
+    """The regime table as JSON records (``summary.json``'s ``"regimes"`` of ``jaxcelt bifurcation``).
+
+    Contiguous runs of equal (local regime, global motion) along the swept axis, every lane labelled
+    ``"<regime>, <global motion>"`` (``"invalid, unknown"`` too): ``{"from", "to", "n", "label"}`` each;
+    then, if any lane has a Lyapunov exponent, ``{"lyapunov_range_per_s": [min, max]}``. A multi-start
+    dataset is labelled by its first start."""
+    vals, reg, per, glob = _first_start(ds)
+    labels = [f"{n}, {GLOBAL_MOTION[int(g)]}" for n, g in zip(regime_names(reg, per), glob)]
+    out: list[dict] = [{"from": a, "to": b, "n": k, "label": label} for a, b, k, label in _runs(vals, labels)]
+    lam = ds["lyapunov"].values
+    if np.isfinite(lam).any():
+        out.append({"lyapunov_range_per_s": [float(np.nanmin(lam)), float(np.nanmax(lam))]})
     return out
