@@ -48,7 +48,7 @@ def gc_paused() -> Iterator[None]:
 
     Tracing a program that holds an ODE solve allocates millions of objects that live until the
     trace ends, and every full collection during the trace walks all of them; without collections
-    the traces of the sweep's pool, its Lyapunov stage and `jaxcelt.sweeps.sweep.orbit` are faster. The
+    the traces of the sweep's pool, its Lyapunov stage and `jaxcelt.sweeps.dense.dense_trajectory` are faster. The
     block's cycles are collected later, as usual."""
     enabled = gc.isenabled()
     gc.disable()
