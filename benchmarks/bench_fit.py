@@ -10,7 +10,7 @@ with the persistent XLA cache (cold fill, then a second process that reads it).
 Problems (``--problems``): ``4p`` (above); ``release`` (the same two records as gyro +
 accelerometer, releases with headings 0.3 and -0.5 rad, the release states fitted with the four
 parameters from a guess 0.2 rad off in heading, 3 deg off in tilt and 20 % off in spin,
-`jaxcelt.identify.fit.fit_staged` over 0.3 s then 1 s, noise-free); ``chaos`` (the omega_pi = 19 record
+`jaxcelt.identify.strategies.fit_staged` over 0.3 s then 1 s, noise-free); ``chaos`` (the omega_pi = 19 record
 of ``docs/fit/chaos_data.npz``: 40 periods, full state, chaotic along the truth; multiple shooting
 with 40 windows, window states from the data, continuity weight 1, from the study's start 30-50 %
 off, a 300 s budget per fit); ``adam-long`` (problem ``4p``, Adam with 3000 iterations: whether
@@ -41,8 +41,8 @@ def other_problem(problem: str, optimiser: str, max_iter: int) -> list[dict]:
     import dataclasses
 
     import jaxcelt as jc
-    from jaxcelt.identify.fit import fit_staged
     from jaxcelt.identify.records import generate_data, load_data
+    from jaxcelt.identify.strategies import fit_staged
 
     paper, true = paper_and_true()
 

@@ -4,7 +4,7 @@ Problem of ``benchmarks/bench_fit.py`` (two 1 s IMU-gyro records of the stone wi
 m_Ts 30-50 % off the paper's values), 1 % noise, Levenberg-Marquardt. Starts: the paper's values
 and ``--starts - 1`` points drawn log-uniformly within a factor 2 of them (seeded). Each mode runs
 in a fresh process without the persistent compilation cache, so its compilation is measured cold:
-``vmapped`` (`jaxcelt.identify.fit.multistart(vmapped=True)`: one vmapped LM step and one vmapped solve of
+``vmapped`` (`jaxcelt.identify.strategies.multistart(vmapped=True)`: one vmapped LM step and one vmapped solve of
 all starts per iteration) and ``sequential`` (``vmapped=False``, the CPU default: the fits one
 after another, sharing one compilation). Reported: compile and run time of the whole call, iterations per start,
 how many starts reached the best loss and the spread of the parameters over them.
@@ -30,7 +30,7 @@ from _fit_problem import FREE, paper_and_true, records  # noqa: E402
 def child(mode: str, n_starts: int) -> dict:
     import numpy as np
 
-    from jaxcelt.identify.fit import multistart
+    from jaxcelt.identify.strategies import multistart
 
     paper, true = paper_and_true()
     data = records(0.01)

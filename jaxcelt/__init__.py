@@ -12,8 +12,9 @@ from jaxcelt import (
     _moved,
 )
 from jaxcelt.ensemble import HostProcesses
-from jaxcelt.identify.fit import FitResult, fit, project_state  # noqa: F811  (jaxcelt.fit is the function)
+from jaxcelt.identify.api import fit  # noqa: F811  (jaxcelt.fit is the function)
 from jaxcelt.identify.records import MeasuredData, Trajectory, generate_data, load_data, save_data
+from jaxcelt.identify.result import FitResult
 from jaxcelt.integrate.lyapunov import celt_lyapunov, largest_lyapunov
 from jaxcelt.integrate.noslip import simulate_noslip
 from jaxcelt.integrate.solve import INVALID_KINDS, STATUS, Solution, simulate
@@ -32,7 +33,7 @@ from jaxcelt.physics.contact.registry import CONTACT_LAWS, get_contact_law
 from jaxcelt.physics.diagnostics import Diagnostics, centre_position, diagnostics, energy, tilt
 from jaxcelt.physics.model import STATE_NAMES, kinematics, normal_force, vector_field
 from jaxcelt.physics.params import PARAM_NAMES, CeltParams
-from jaxcelt.physics.state import check_state, constraint_residual, initial_state
+from jaxcelt.physics.state import check_state, constraint_residual, initial_state, project_state
 from jaxcelt.studies.ladder import Scene, hertz_params, run_ladder
 from jaxcelt.sweeps.api import bifurcation, parameter_map, sweep_lanes
 from jaxcelt.sweeps.census import AttractorCensus, AttractorStarts, attractor_starts, attractors

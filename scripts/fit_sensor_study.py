@@ -7,7 +7,7 @@ b_Ts, m_Ts 30-50 % off the paper's values, in sensor axes rotated by a fixed rot
 -7 ms). Releases: tilted 10 and 6 deg, spinning +5 and -3 rad/s, headings 0.3 and -0.5 rad;
 the fit is told only a guess 0.2 rad off in heading, 3 deg off in tilt and 20 % off in spin, and
 fits the release states (``fit_y0``), the rotation and the offsets with the four parameters, from
-the paper's values, over the first 0.3 s and then the whole second (`jaxcelt.identify.fit.fit_staged`). Over ``--seeds`` noise seeds: errors, and whether the 95 % intervals cover the truth.
+the paper's values, over the first 0.3 s and then the whole second (`jaxcelt.identify.strategies.fit_staged`). Over ``--seeds`` noise seeds: errors, and whether the 95 % intervals cover the truth.
 Resumable: finished seeds are kept in the output file.
 
     python scripts/fit_sensor_study.py [--seeds 20] [--out docs/fit/sensor_study.json]
@@ -25,8 +25,8 @@ from pathlib import Path
 import numpy as np
 
 import jaxcelt as jc
-from jaxcelt.identify.fit import fit_staged
 from jaxcelt.identify.records import generate_data
+from jaxcelt.identify.strategies import fit_staged
 from jaxcelt.versions import versions
 
 FREE = ("mu", "k_r", "b_Ts", "m_Ts")

@@ -14,18 +14,15 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
 import jaxcelt as jc
-import jaxcelt.identify.fit  # noqa: F401  (module, for the helpers below)
+import jaxcelt.identify as F
 import jaxcelt.identify.records as D
 from jaxcelt.plotting import fit as FP
-
-F = sys.modules["jaxcelt.fit"]  # `jaxcelt.fit` the attribute is the function
 
 FREE = ("mu", "k_r", "b_Ts", "m_Ts")
 PAPER = jc.CeltParams.paper()
@@ -357,7 +354,7 @@ def plot_chaos_fit(out, tag):
     n = (ts.size - 1) // K
     idx = np.arange(K)[:, None] * n + np.arange(n + 1)[None, :]
     starts = np.asarray(tr.y0)[None] if K == 1 else ys[idx[:, 0]]
-    proj = jax.vmap(lambda y: F.project_state(y, p))(starts)
+    proj = jax.vmap(lambda y: jc.project_state(y, p))(starts)
 
     def one(y0, tw):
         return jc.simulate(p, y0, tw[-1], t0=tw[0], ts=tw, rtol=1e-8, atol=1e-10, max_steps=200_000).ys

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 import jaxcelt as jc
-from jaxcelt.identify.records import OBSERVABLES, MeasuredData, generate_data, load_data, observe, save_data
+from jaxcelt.identify.observe import OBSERVABLES, observe
+from jaxcelt.identify.records import MeasuredData, generate_data, load_data, save_data
 
 
 @pytest.fixture(scope="module")

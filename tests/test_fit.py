@@ -9,17 +9,21 @@ shared cores): 14-320 s each; the longest is must show 3 (321 s at load ~10).
 """
 
 import dataclasses
-import sys
 
 import jax.numpy as jnp
 import numpy as np
 import pytest
 
 import jaxcelt as jc
-from jaxcelt.identify.fit import Affine, Bounded, Positive, project_state
+from jaxcelt.identify import program
+from jaxcelt.identify.chaos import gradient_norm_vs_window
+from jaxcelt.identify.config import FitConfig
+from jaxcelt.identify.problem import build_problem, residuals, value_and_jacobian
 from jaxcelt.identify.records import generate_data, save_data
+from jaxcelt.identify.strategies import multistart, profile_likelihood, random_guesses
+from jaxcelt.identify.transforms import Affine, Bounded, Positive
+from jaxcelt.physics.state import project_state
 
-F = sys.modules["jaxcelt.fit"]
 FREE = ("mu", "k_r", "b_Ts", "m_Ts")
 PAPER = jc.CeltParams.paper()
 TRUE = PAPER.replace(mu=0.2241 * 1.4, k_r=0.4345 * 0.6, b_Ts=0.5305 * 1.5, m_Ts=0.8161 * 1.35)
@@ -62,16 +66,15 @@ def test_project_state_lands_on_manifold():
 
 @pytest.mark.slow  # its own compilation of the forward-mode Jacobian (~30 s idle, ~2 min loaded)
 def test_jacobian_matches_finite_differences(short_imu):
-    prob, z = F._build(
-        short_imu.subset(["omega"]), PAPER, FREE, {}, {}, 1, "optimise", False, 1.0, "fwd", 1e-10, 1e-12, 100_000
-    )
+    config = FitConfig(free=FREE, continuity_weight=1.0, sim_rtol=1e-10, sim_atol=1e-12, max_steps=100_000)
+    prob, z = build_problem(short_imu.subset(["omega"]), PAPER, config)
     zf = z["params"]
-    r, J = F._value_and_jacobian(prob, zf)
+    r, J = value_and_jacobian(prob, zf)
     h = 1e-6
     for i in range(len(FREE)):
         e = jnp.zeros(len(FREE)).at[i].set(h)
-        rp = F._residuals(prob, prob.unflatten(zf + e))[0]
-        rm = F._residuals(prob, prob.unflatten(zf - e))[0]
+        rp = residuals(prob, prob.unflatten(zf + e))[0]
+        rm = residuals(prob, prob.unflatten(zf - e))[0]
         fd = (rp - rm) / (2 * h)
         # central differences with adaptive steps (rtol 1e-10): truncation + step-selection noise
         # ~1e-4 of the column norm; a wrong Jacobian is off by O(1)
@@ -101,7 +104,7 @@ def test_vmapped_multistart_equals_sequential_fits(short_imu):
     in z; a wrong lane bookkeeping would mix starts or stop early, errors of O(1e-2) and more)."""
     data = short_imu.subset(["omega"])
     guesses = [{}, {"mu": 0.28, "k_r": 0.3}]
-    best, summ = F.multistart(data, PAPER, guesses, free=FREE, optimiser="lm", max_iter=60, vmapped=True)
+    best, summ = multistart(data, PAPER, guesses, free=FREE, optimiser="lm", max_iter=60, vmapped=True)
     assert summ["vmapped"] and summ["n_at_best"] == 2, summ
     for g, lane in zip(guesses, summ["fits"], strict=True):
         seq = jc.fit(data, PAPER.replace(**g), free=FREE, optimiser="lm", max_iter=60)
@@ -112,7 +115,7 @@ def test_vmapped_multistart_equals_sequential_fits(short_imu):
     assert np.isfinite(best.stderr["mu"]) and best.loss == min(f["loss"] for f in summ["fits"])
     assert summ["fits"][1]["values"] != summ["fits"][0]["values"]  # each lane's own result
     with pytest.raises(ValueError, match="not a free parameter"):
-        F.multistart(data, PAPER, [{"g": 9.0}], free=FREE, vmapped=True)
+        multistart(data, PAPER, [{"g": 9.0}], free=FREE, vmapped=True)
 
 
 def test_records_in_parallel_equal_one_program(monkeypatch):
@@ -123,14 +126,15 @@ def test_records_in_parallel_equal_one_program(monkeypatch):
     optimised window states (two records, two windows each), also batched as in `multistart`."""
     y0s = [_start(TRUE), jc.initial_state(TRUE, omega=(0.0, 0.0, -3.0), n=(0.1, 0.0, np.sqrt(0.99)))]
     data = generate_data(TRUE, y0s, 0.2, rate=50, kinds=("omega", "accel"), sensor_rotation=[0.05, 0.0, 0.1])
-    prob, z = F._build(data, PAPER, FREE, {}, {}, 2, "optimise", True, 1e4, "fwd", 1e-10, 1e-12, 4000,
-                       None, [0.01, -0.02], True, True)  # fmt: skip
+    config = FitConfig(free=FREE, windows=2, fit_y0=True, sim_rtol=1e-10, sim_atol=1e-12, max_steps=4000,
+                       time_offset=[0.01, -0.02], fit_rotation=True, fit_time_offset=True)  # fmt: skip
+    prob, z = build_problem(data, PAPER, config)
     zf = np.asarray(prob.flatten(z))
     zs = zf + 0.01 * np.random.default_rng(1).standard_normal((2, zf.size))
-    monkeypatch.setattr(F, "_cpu_workers", lambda: 2)
+    monkeypatch.setattr(program, "cpu_workers", lambda: 2)
     for x in (zs[0], zs):
-        r1, J1 = F._evaluate(prob, x)
-        r0, J0 = F._evaluate_program(prob, x)
+        r1, J1 = program.evaluate(prob, x)
+        r0, J0 = program.evaluate_program(prob, x)
         assert r1.shape == r0.shape and J1.shape == J0.shape
         assert np.linalg.norm(r1 - r0) <= 1e-8 * np.linalg.norm(r0)
         assert np.linalg.norm(J1 - J0) <= 1e-8 * np.linalg.norm(J0)
@@ -166,16 +170,16 @@ def test_cli_fit(tmp_path, short_imu, capsys):
 
 
 def test_random_guesses_inside_ranges():
-    g = F.random_guesses(PAPER, 50, spread=float(np.log(2.0)), seed=1)
+    g = random_guesses(PAPER, 50, spread=float(np.log(2.0)), seed=1)
     assert g[0] == {} and len(g) == 50 and g[1] != g[2]
     for n in ("mu", "k_r", "b_Ts"):  # Positive: within a factor 2
         r = np.array([x[n] / float(getattr(PAPER, n)) for x in g[1:]])
         assert r.min() >= 0.5 - 1e-12 and r.max() <= 2.0 + 1e-12 and r.max() / r.min() > 2.0
     m = np.array([x["m_Ts"] for x in g[1:]])
     assert 0.0 < m.min() and m.max() < 2.0  # Bounded(0, 2)
-    assert F.random_guesses(PAPER, 3, seed=1) == F.random_guesses(PAPER, 3, seed=1)
+    assert random_guesses(PAPER, 3, seed=1) == random_guesses(PAPER, 3, seed=1)
     with pytest.raises(ValueError, match="n must be"):
-        F.random_guesses(PAPER, 0)
+        random_guesses(PAPER, 0)
 
 
 def test_fit_argument_errors(short_imu):
@@ -245,11 +249,12 @@ def test_gradient_norm_vs_window_matches_reverse_mode(short_imu):
     import jax
 
     data = short_imu.subset(["omega"])
-    T, g = F.gradient_norm_vs_window(data, PAPER, [20, 50], free=FREE)
+    T, g = gradient_norm_vs_window(data, PAPER, [20, 50], free=FREE)
     tr = data.trajectories[0]
     assert T == pytest.approx([tr.ts[20], tr.ts[50]])
     sub = dataclasses.replace(tr, ts=tr.ts[:21], obs={k: v[:21] for k, v in tr.obs.items()})
-    prob, z = F._build(jc.MeasuredData((sub,)), PAPER, FREE, {}, {}, 1, "data", False, 1.0, "rev", 1e-8, 1e-10, 200_000)
+    config = FitConfig(free=FREE, window_states="data", continuity_weight=1.0, max_steps=200_000)
+    prob, z = build_problem(jc.MeasuredData((sub,)), PAPER, config, mode="rev")
     ref = float(jnp.linalg.norm(jax.grad(lambda zz: prob.loss(zz))(z)["params"]))
     assert g[0] == pytest.approx(ref, rel=1e-5)
     assert g[1] > g[0]
@@ -321,13 +326,13 @@ def test_multistart_and_profile_likelihood():
     within a factor 2 in width: with 1 % noise the loss is close to quadratic over +-2 se, so the
     two must be close; a wrong s^2 or delta scaling would be off by orders of magnitude."""
     data = generate_data(TRUE, _start(TRUE), 0.5, rate=100, kinds=("omega",), noise=0.01, seed=3)
-    best, summ = F.multistart(data, PAPER, [{}, {"mu": 0.28, "k_r": 0.3}], free=FREE, optimiser="lm", max_iter=60)
+    best, summ = multistart(data, PAPER, [{}, {"mu": 0.28, "k_r": 0.3}], free=FREE, optimiser="lm", max_iter=60)
     assert summ["n_at_best"] == 2, summ
     for n in FREE:
         lo, hi = summ["spread"][n]
         assert hi - lo <= 1e-4 * best.stderr[n] + 1e-12 * abs(best.values[n])
     v, se = best.values["b_Ts"], best.stderr["b_Ts"]
-    prof = F.profile_likelihood(data, best, "b_Ts", v + se * np.linspace(-3, 3, 7), optimiser="lm", max_iter=60)
+    prof = profile_likelihood(data, best, "b_Ts", v + se * np.linspace(-3, 3, 7), optimiser="lm", max_iter=60)
     lo, hi = prof["interval"]
     assert lo < v < hi
     glo, ghi = prof["ci95_gauss_newton"]
@@ -357,7 +362,7 @@ def test_rotation_matrix_against_scipy():
     1e-14 (a few ulp of O(1) entries); the series branch below |r| = 1e-6 is exact to O(|r|^4)."""
     from scipy.spatial.transform import Rotation
 
-    from jaxcelt.identify.records import rotation_matrix
+    from jaxcelt.identify.observe import rotation_matrix
 
     for r in ([0.05, -0.03, 0.08], [1.0, 2.0, -0.5], [1e-8, 0.0, 3e-8], [0.0, 0.0, 0.0]):
         np.testing.assert_allclose(np.asarray(rotation_matrix(r)), Rotation.from_rotvec(r).as_matrix(), atol=1e-14)
@@ -367,7 +372,7 @@ def test_generate_data_sensor_axes_and_time_offset():
     """Sensor-axes gyro = R times the body-axes gyro of the same record; a time offset tau starts the
     record at model time tau: equal to `simulate` from y0 at t0 = tau (noise-free, both at the
     generator's tolerances; 1e-9 rad/s covers two solves of the same problem at rtol 1e-10)."""
-    from jaxcelt.identify.records import rotation_matrix
+    from jaxcelt.identify.observe import rotation_matrix
 
     rv, tau = np.array([0.05, -0.03, 0.08]), 0.013
     y0 = _start(TRUE)

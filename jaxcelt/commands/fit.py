@@ -70,10 +70,10 @@ def register(sub) -> None:
     p.add_argument("--fit-time-offset", action="store_true",
                    help="also fit each record's time offset (the base's phase at the record's t = 0)")  # fmt: skip
     p.add_argument("--spans", type=floats_list, default=None, metavar="S1,S2,...",
-                   help="fit the first S1 seconds of every record, then S2, ... (jaxcelt.identify.fit.fit_staged)")  # fmt: skip
+                   help="fit the first S1 seconds of every record, then S2, ... (jaxcelt.identify.strategies.fit_staged)")  # fmt: skip
     p.add_argument("--starts", type=positive_int, default=1,
-                   help="fit from this many starts (jaxcelt.identify.fit.multistart: vmapped on a GPU): the guess and "
-                   "starts drawn within a factor 2 of it (jaxcelt.identify.fit.random_guesses); reports the best fit and "
+                   help="fit from this many starts (jaxcelt.identify.strategies.multistart: vmapped on a GPU): the guess and "
+                   "starts drawn within a factor 2 of it (jaxcelt.identify.strategies.random_guesses); reports the best fit and "
                    "the spread")  # fmt: skip
     p.add_argument("--seed", type=int, default=0, help="seed of the random starts")
     p.add_argument("--max-iter", type=positive_int, default=100)
@@ -88,8 +88,9 @@ def run(args) -> int:
     from tqdm import tqdm
 
     import jaxcelt as jc
-    from jaxcelt.identify.fit import fit, fit_staged, multistart, random_guesses
+    from jaxcelt.identify.api import fit
     from jaxcelt.identify.records import MeasuredData, load_csv, load_data
+    from jaxcelt.identify.strategies import fit_staged, multistart, random_guesses
 
     # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2)
     params0 = jc.CeltParams.paper(**overrides(args.set))

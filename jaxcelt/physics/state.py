@@ -1,4 +1,4 @@
-"""Consistent initial states on the contact manifold, and their validation (MODEL.md section 8)."""
+"""Consistent initial states on the contact manifold, their validation and the projection onto it (MODEL.md section 8)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from jaxcelt._types import ArrayLike, State
 from jaxcelt.physics.model import contact_geometry, horizontal_frame
 from jaxcelt.physics.params import CeltParams
 
-__all__ = ["initial_state", "check_state", "constraint_residual", "MANIFOLD_TOL"]
+__all__ = ["initial_state", "check_state", "constraint_residual", "project_state", "MANIFOLD_TOL"]
 
 MANIFOLD_TOL = 1e-6
 """Tolerance of `check_state`: |n| - 1, v_A . n [m/s] and contact height [m]. Loose enough for
@@ -141,3 +141,19 @@ def check_state(y: ArrayLike, params: CeltParams, *, name: str = "y0", tol: floa
             raise ValueError(
                 f"{where!r}: r_C3 inconsistent with the contact (off by {h:.3g} m; use jaxcelt.initial_state)"
             )
+
+
+def project_state(y: State, params: CeltParams) -> State:
+    """Project a 13-vector onto the contact manifold (MODEL.md section 8).
+
+    Normalises n, removes the normal component of the contact-point velocity v_A = v + omega x rho
+    (eq. 2) and sets r_C3 to the height of C above the contact (-rho . n). Differentiable.
+    """
+    v, w, n, r_C, psi = y[0:3], y[3:6], y[6:9], y[9:12], y[12:13]
+    n = n / jnp.linalg.norm(n)
+    rho = contact_geometry(n, w, params).rho
+    v_A = v + jnp.cross(w, rho)
+    v_A = v_A - jnp.dot(v_A, n) * n
+    v = v_A - jnp.cross(w, rho)
+    r_C = r_C.at[2].set(-jnp.dot(rho, n))
+    return jnp.concatenate([v, w, n, r_C, psi])

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from jaxcelt.identify.records import OBSERVABLES
+from jaxcelt.identify.observe import OBSERVABLES
 
 _CHANNELS = {
     "state": ("v1", "v2", "v3", "ω1", "ω2", "ω3", "n1", "n2", "n3", "rC1", "rC2", "rC3", "ψ"),
@@ -26,7 +26,7 @@ def plot_fit(result, *, title: str = "", true=None, kind: str | None = None, cha
     plus the loss history and the relative parameter error per iteration."""
     import matplotlib.pyplot as plt
 
-    from jaxcelt.identify.fit import predict
+    from jaxcelt.identify.result import predict
 
     pred = predict(result)[0]
     kind = kind or next(iter(pred["data"]))

@@ -1,0 +1,95 @@
+"""`fit`: gradient-based identification of model parameters from measured trajectories.
+
+A fit builds the least-squares problem (`jaxcelt.identify.problem`) of the records and the configuration
+(`jaxcelt.identify.config.FitConfig`), iterates an optimiser (`jaxcelt.identify.optimisers`) whose residuals and
+forward-mode Jacobians come from one compiled evaluation program (`jaxcelt.identify.program`), and reports the
+optimum with its Gauss-Newton uncertainty (`jaxcelt.identify.result.FitResult`). A fit keeps no state between calls:
+fits of different data may run at the same time in different threads. Strategies built on it (growing spans,
+multi-start, profile likelihood) are in `jaxcelt.identify.strategies`.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from jaxcelt import _config  # noqa: F401
+from jaxcelt.identify.config import FitConfig
+from jaxcelt.identify.optimisers import run
+from jaxcelt.identify.problem import Problem, build_problem
+from jaxcelt.identify.program import evaluate
+from jaxcelt.identify.records import MeasuredData
+from jaxcelt.identify.result import FitResult, make_result
+from jaxcelt.physics.params import CeltParams
+
+__all__ = ["fit", "fit_with", "prepare"]
+
+
+def fit(
+    data: MeasuredData,
+    params0: CeltParams,
+    *,
+    free: Sequence[str] = ("mu", "k_r", "b_Ts", "m_Ts"),
+    optimiser: str = "lm",
+    weights: dict[str, float] | None = None,
+    transforms: dict[str, Any] | None = None,
+    windows: int = 1,
+    window_states: str = "optimise",
+    fit_y0: bool = False,
+    sensor_rotation: Any = None,
+    fit_rotation: bool = False,
+    time_offset: Any = 0.0,
+    fit_time_offset: bool = False,
+    continuity_weight: float = 1e4,
+    max_iter: int = 100,
+    rtol: float = 1e-8,
+    atol: float = 1e-8,
+    sim_rtol: float = 1e-8,
+    sim_atol: float = 1e-10,
+    max_steps: int | None = None,
+    learning_rate: float = 0.02,
+    gtol: float = 1e-9,
+    uncertainty: bool = True,
+    max_time: float | None = None,
+    callback: Callable[[int, float, dict[str, float]], None] | None = None,
+    config: FitConfig | None = None,
+    options: FitConfig | None = None,
+) -> FitResult:
+    """Fit the free parameters to measured trajectories.
+
+    Args:
+        data: `jaxcelt.identify.records.MeasuredData` (any observation kinds; several records, each with its
+            own omega_pi, q_pi).
+        params0: starting parameters (also the values of every parameter that is not free).
+        free, optimiser, weights, transforms, windows, window_states, fit_y0, sensor_rotation, fit_rotation,
+            time_offset, fit_time_offset, continuity_weight, max_iter, rtol, atol, sim_rtol, sim_atol, max_steps,
+            learning_rate, gtol, uncertainty, max_time, callback: the fields of
+            `jaxcelt.identify.config.FitConfig`, documented there (same defaults).
+        config: the whole configuration as one `FitConfig` instead of the keywords (``options`` is another name
+            for it). Passing it together with any keyword that differs from its default is a ValueError.
+
+    Returns:
+        `FitResult`.
+    """
+    keywords = {k: v for k, v in locals().items() if k not in ("data", "params0", "config", "options")}
+    if config is not None and options is not None:
+        raise ValueError("fit: pass config= or options= (the same thing), not both")
+    return fit_with(data, params0, FitConfig.from_keywords(keywords, config if config is not None else options))
+
+
+def prepare(data: MeasuredData, params0: CeltParams, config: FitConfig) -> tuple[Problem, np.ndarray]:
+    """The problem of a fit and its flat starting unknowns z."""
+    prob, z = build_problem(data, params0, config)
+    return prob, prob.flatten(z)
+
+
+def fit_with(data: MeasuredData, params0: CeltParams, config: FitConfig) -> FitResult:
+    """`fit` with its configuration as one `FitConfig`."""
+    prob, zf = prepare(data, params0, config)
+    t_start = time.perf_counter()
+    trace = run(prob, zf, config, t_start)
+    r, J = evaluate(prob, np.asarray(trace.zf))
+    return make_result(prob, trace, r, J, config, t_start)
