@@ -16,8 +16,14 @@ The root is found by `optimistix.root_find` (Newton by default; its Jacobian is 
 of the discrete map, so Newton converges quadratically to the root of the map actually
 computed). At the root the monodromy matrix comes from the variational equations integrated
 with the orbit under one error control (`variational_map`), mapped to local coordinates by
-the chain rule, M = d chart . Phi . d embed; the Floquet multipliers are its eigenvalues. Everything is pure and jittable; ``jax.vmap`` over guesses (or args) gives a
-batch in which a failed lane is marked by ``status`` instead of raising.
+the chain rule, M = d chart . Phi . d embed (`chart_monodromy`); the Floquet multipliers are its
+eigenvalues. Everything is pure and jittable; ``jax.vmap`` over guesses (or args) gives a batch in
+which a failed lane is marked by ``status`` instead of raising.
+
+`OrbitFamily` is the same problem with one parameter lam free, u = (z, lam): its residual, the
+re-centring of the chart and the multipliers at a point are what `jaxcelt.orbits.branch` continues.
+Solver and Newton settings are one `jaxcelt.orbits.options.ShootingOptions` (``options=``, or single
+keywords).
 """
 
 from __future__ import annotations
