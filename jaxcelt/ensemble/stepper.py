@@ -41,14 +41,13 @@ from jaxcelt.ensemble.lanes import LaneMonitor, LaneState
 from jaxcelt.integrate.solve import (
     MinStepController,
     MonitoredSolver,
-    _Field,
     _fill_implicit_tols,
     invalid_kind,
     step_too_small,
 )
 from jaxcelt.physics.contact.laws import AbstractContactLaw
 from jaxcelt.physics.contact.registry import get_contact_law
-from jaxcelt.physics.model import field_time, vector_field_and_normal
+from jaxcelt.physics.model import CeltField, field_time, vector_field_and_normal
 from jaxcelt.physics.params import CeltParams
 
 __all__ = [
@@ -376,7 +375,7 @@ def make_stepper(
     `FusedERKStepper`."""
     law = get_contact_law(contact_law)
     wrapped = MonitoredSolver(solver=_fill_implicit_tols(solver, rtol, atol), law=law)
-    term = wrap_term(diffrax.ODETerm(_Field(law)))
+    term = wrap_term(diffrax.ODETerm(CeltField(law)))
     tab = erk_tableau(solver)
     if tab is None:
         return DiffraxStepper(solver=wrapped, term=term, max_steps=max_steps, stop_on_invalid=stop_on_invalid)

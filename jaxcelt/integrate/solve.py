@@ -250,9 +250,6 @@ def status_code(result) -> Array:
     ).astype(jnp.int32)
 
 
-_Field = CeltField  # the name the lane stepper imports (jaxcelt.ensemble.stepper)
-
-
 def _fill_implicit_tols(solver, rtol, atol):
     # diffeqsolve would copy the controller's tolerances into an implicit solver's root finder;
     # it cannot reach through our wrapper, so do it before wrapping.
