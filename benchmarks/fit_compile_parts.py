@@ -1,7 +1,7 @@
 """Where a fit's compilation goes (writes docs/fit/compile_parts.json).
 
 The problem of ``benchmarks/bench_fit.py`` (two 1 s gyro records, 4 parameters). For the evaluation
-program (`jaxcelt.identify.fit._value_and_jacobian`: residuals and forward-mode Jacobian) it times tracing +
+program (`jaxcelt.identify.problem.value_and_jacobian`: residuals and forward-mode Jacobian) it times tracing +
 lowering and XLA compilation apart, counts the host callbacks in it, and -- in two fresh processes
 sharing an empty persistent compilation cache -- whether the second process loads it from the cache.
 Modes: ``raise``, equinox's runtime checks as host callbacks (equinox's default); ``nan``, traced
@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import importlib
 import json
 import os
 import subprocess
@@ -35,17 +34,17 @@ FUSION_EMITTERS_OFF = {"xla_cpu_use_fusion_emitters": False}
 def child(mode: str) -> dict:
 
     from jaxcelt._diffrax_adapter import runtime_checks_as_nan
-
-    F = importlib.import_module("jaxcelt.fit")  # the module (jaxcelt.fit is also the function)
+    from jaxcelt.identify.config import FitConfig
+    from jaxcelt.identify.problem import build_problem, value_and_jacobian
     paper, _ = paper_and_true()
     data = records()
-    prob, z = F._build(data, paper, ("mu", "k_r", "b_Ts", "m_Ts"), {}, {}, 1, "optimise", False, 1e4, "fwd",
-                       1e-8, 1e-10, 2000)  # fmt: skip
+    config = FitConfig(free=("mu", "k_r", "b_Ts", "m_Ts"), max_steps=2000)
+    prob, z = build_problem(data, paper, config)
     zf = prob.flatten(z)
     ctx = runtime_checks_as_nan() if mode != "raise" else contextlib.nullcontext()
     with ctx:
         t0 = time.perf_counter()
-        low = F._value_and_jacobian.lower(prob, zf)
+        low = value_and_jacobian.lower(prob, zf)
         t1 = time.perf_counter()
     exe = low.compile(compiler_options=FUSION_EMITTERS_OFF) if mode == "nan-options" else low.compile()
     t2 = time.perf_counter()

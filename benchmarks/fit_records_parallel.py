@@ -2,9 +2,9 @@
 (writes docs/fit/records_parallel.json).
 
 The problem of ``benchmarks/bench_fit.py`` (two 1 s gyro records, 4 parameters) at the paper's
-values: (r, J) by ``jaxcelt.identify.fit._evaluate`` (on a multi-core CPU: each record by the one-record
+values: (r, J) by ``jaxcelt.identify.program.evaluate`` (on a multi-core CPU: each record by the one-record
 program in its own thread), by the all-records program (`jax.lax.map` over the records,
-``_evaluate_program``), and by the one-record program called for each record in turn. Compiled
+``evaluate_program``), and by the one-record program called for each record in turn. Compiled
 first; best of ``--reps`` warm calls each; the results of the modes are compared.
 
     python benchmarks/fit_records_parallel.py [--reps 10] [--out docs/fit/records_parallel.json]
@@ -13,7 +13,6 @@ first; best of ``--reps`` warm calls each; the results of the modes are compared
 from __future__ import annotations
 
 import argparse
-import importlib
 import json
 import os
 import sys
@@ -31,21 +30,22 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     import numpy as np
 
+    from jaxcelt.identify import program as F
+    from jaxcelt.identify.config import FitConfig
+    from jaxcelt.identify.problem import build_problem
     from jaxcelt.versions import versions
-
-    F = importlib.import_module("jaxcelt.fit")  # the module (jaxcelt.fit is also the function)
     paper, _ = paper_and_true()
     data = records()
-    prob, z = F._build(data, paper, ("mu", "k_r", "b_Ts", "m_Ts"), {}, {}, 1, "optimise", False, 1e4, "fwd",
-                       1e-8, 1e-10, 2000)  # fmt: skip
+    config = FitConfig(free=("mu", "k_r", "b_Ts", "m_Ts"), max_steps=2000)
+    prob, z = build_problem(data, paper, config)
     zf = np.asarray(prob.flatten(z))
-    parts = [F._one_record(prob, i) for i in range(prob.n_records)]
+    parts = [F.one_record(prob, i) for i in range(prob.n_records)]
     modes = {
-        "threads": lambda: F._evaluate(prob, zf),
-        "one_program_lax_map": lambda: F._evaluate_program(prob, zf),
-        "records_in_turn": lambda: [F._evaluate_program(p, zf[..., c]) for p, c, _ in parts],
+        "threads": lambda: F.evaluate(prob, zf),
+        "one_program_lax_map": lambda: F.evaluate_program(prob, zf),
+        "records_in_turn": lambda: [F.evaluate_program(p, zf[..., c]) for p, c, _ in parts],
     }
-    out = dict(versions=versions(), cpus=F._cpu_workers(), load_before=os.getloadavg(), reps=a.reps, best_s={})
+    out = dict(versions=versions(), cpus=F.cpu_workers(), load_before=os.getloadavg(), reps=a.reps, best_s={})
     results = {}
     for name, f in modes.items():
         results[name] = f()  # compile
