@@ -112,16 +112,18 @@ def test_second_process_loads_the_fit_program(tmp_path):
         import numpy as np
         import jaxcelt as jc
         from jaxcelt import _executable_cache as ec
+        from jaxcelt.identify.config import FitConfig
+        from jaxcelt.identify.problem import build_problem
+        from jaxcelt.identify.program import evaluate
         from jaxcelt.identify.records import generate_data
-        F = sys.modules["jaxcelt.fit"]
         p = jc.CeltParams.paper()
         y0 = jc.initial_state(p, omega=(0.0, 0.0, 5.0), n=(0.17, 0.0, 0.985), normalize=True)
         data = generate_data(p, y0, 0.1, rate=50, kinds=("omega",))
-        prob, z = F._build(data, p, ("mu", "k_r"), {{}}, {{}}, 1, "optimise", False, 1.0, "fwd", 1e-8, 1e-10, 2000)
+        prob, z = build_problem(data, p, FitConfig(free=("mu", "k_r"), continuity_weight=1.0, max_steps=2000))
         lowered = []
         real = ec.jax.jit
         ec.jax.jit = lambda fn, *a, **k: (lowered.append(1), real(fn, *a, **k))[1]
-        r, J = F._evaluate(prob, np.asarray(prob.flatten(z)) + 0.1)
+        r, J = evaluate(prob, np.asarray(prob.flatten(z)) + 0.1)
         print(json.dumps(dict(lowered=len(lowered), r=r.tolist(), J=J.ravel().tolist())))
         """
     )

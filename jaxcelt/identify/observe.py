@@ -18,6 +18,9 @@ The IMU kinds (`SENSOR_KINDS`) are recorded in the sensor's own axes: h_sensor =
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from types import MappingProxyType
+
 import jax.numpy as jnp
 
 from jaxcelt import _config  # noqa: F401
@@ -28,10 +31,10 @@ from jaxcelt.physics.params import CeltParams
 
 __all__ = ["OBSERVABLES", "SENSOR_KINDS", "observe", "specific_force", "rotation_matrix"]
 
-OBSERVABLES: dict[str, int] = {"state": 13, "omega": 3, "orientation": 4, "centre": 3, "accel": 3}
+OBSERVABLES: Mapping[str, int] = MappingProxyType({"state": 13, "omega": 3, "orientation": 4, "centre": 3, "accel": 3})
 """Observation kind -> number of channels: the state; omega (a gyro in body axes) [rad/s];
 orientation (n, psi); centre (the geometric centre O, global) [m]; accel (an accelerometer at the
-mass centre C in body axes: the specific force a - g, what an IMU measures) [m/s^2]."""
+mass centre C in body axes: the specific force a - g, what an IMU measures) [m/s^2]. Read-only."""
 
 
 SENSOR_KINDS = ("omega", "accel")

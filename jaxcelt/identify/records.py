@@ -28,8 +28,9 @@ from __future__ import annotations
 
 import dataclasses
 import json
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
+from types import MappingProxyType
 
 import jax
 import jax.numpy as jnp
@@ -295,13 +296,13 @@ def load_data(path: str | Path) -> MeasuredData:
 
 
 # ----------------------------------------------------------------------------- arrays and CSV
-CSV_COLUMNS: dict[str, tuple[str, ...]] = {
+CSV_COLUMNS: Mapping[str, tuple[str, ...]] = MappingProxyType({
     "omega": ("omega1", "omega2", "omega3"),
     "orientation": ("n1", "n2", "n3", "psi"),
     "centre": ("x_O", "y_O", "z_O"),
     "accel": ("f1", "f2", "f3"),
     "state": tuple(f"y{i}" for i in range(13)),
-}
+})
 """CSV column names per observation kind (units: omega [rad/s] in body axes, n [-], psi [rad],
 centre [m], accel [m/s^2] in body axes, state as MODEL.md section 8)."""
 
