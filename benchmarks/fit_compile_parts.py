@@ -34,11 +34,11 @@ FUSION_EMITTERS_OFF = {"xla_cpu_use_fusion_emitters": False}
 def child(mode: str) -> dict:
 
     from jaxcelt._diffrax_adapter import runtime_checks_as_nan
-    from jaxcelt.identify.config import FitConfig
+    from jaxcelt.identify.options import FitOptions
     from jaxcelt.identify.problem import build_problem, value_and_jacobian
     paper, _ = paper_and_true()
     data = records()
-    config = FitConfig(free=("mu", "k_r", "b_Ts", "m_Ts"), max_steps=2000)
+    config = FitOptions(free=("mu", "k_r", "b_Ts", "m_Ts"), max_steps=2000)
     prob, z = build_problem(data, paper, config)
     zf = prob.flatten(z)
     ctx = runtime_checks_as_nan() if mode != "raise" else contextlib.nullcontext()

@@ -31,12 +31,12 @@ def main(argv=None) -> int:
     import numpy as np
 
     from jaxcelt.identify import program as F
-    from jaxcelt.identify.config import FitConfig
+    from jaxcelt.identify.options import FitOptions
     from jaxcelt.identify.problem import build_problem
     from jaxcelt.versions import versions
     paper, _ = paper_and_true()
     data = records()
-    config = FitConfig(free=("mu", "k_r", "b_Ts", "m_Ts"), max_steps=2000)
+    config = FitOptions(free=("mu", "k_r", "b_Ts", "m_Ts"), max_steps=2000)
     prob, z = build_problem(data, paper, config)
     zf = np.asarray(prob.flatten(z))
     parts = [F.one_record(prob, i) for i in range(prob.n_records)]

@@ -13,12 +13,14 @@ from jaxcelt import (
 )
 from jaxcelt.ensemble import HostProcesses
 from jaxcelt.identify.api import fit  # noqa: F811  (jaxcelt.fit is the function)
+from jaxcelt.identify.options import FitOptions
 from jaxcelt.identify.records import MeasuredData, Trajectory, generate_data, load_data, save_data
 from jaxcelt.identify.result import FitResult
 from jaxcelt.integrate.lyapunov import celt_lyapunov, largest_lyapunov
 from jaxcelt.integrate.noslip import simulate_noslip
 from jaxcelt.integrate.solve import INVALID_KINDS, STATUS, Solution, simulate
 from jaxcelt.orbits.celt import CeltOrbit, continue_orbit, periodic_orbit
+from jaxcelt.orbits.options import ShootingOptions
 from jaxcelt.physics.contact.elliptic import contact_integrals, ellipke
 from jaxcelt.physics.contact.integral import (
     CustomProfile,
@@ -39,6 +41,7 @@ from jaxcelt.sweeps.api import bifurcation, parameter_map, sweep_lanes
 from jaxcelt.sweeps.census import AttractorCensus, AttractorStarts, attractor_starts, attractors
 from jaxcelt.sweeps.following import continuation
 from jaxcelt.sweeps.following import follow_attractor as follow_attractor  # new name of continuation
+from jaxcelt.sweeps.options import SweepOptions
 from jaxcelt.sweeps.result import SweepResult
 
 __version__ = "0.1.0"
@@ -53,7 +56,9 @@ __all__ = [
     "CeltOrbit",
     "periodic_orbit",
     "continue_orbit",
+    "ShootingOptions",
     "FitResult",
+    "FitOptions",
     "MeasuredData",
     "Trajectory",
     "fit",
@@ -67,6 +72,8 @@ __all__ = [
     "bifurcation",
     "celt_lyapunov",
     "continuation",
+    "follow_attractor",
+    "SweepOptions",
     "parameter_map",
     "sweep_lanes",
     "largest_lyapunov",

@@ -51,7 +51,7 @@ MOVED: Mapping[str, tuple[str, ...]] = MappingProxyType(
         "data": ("jaxcelt.identify.observe", "jaxcelt.identify.records"),
         "fit": (
             "jaxcelt.identify.transforms",
-            "jaxcelt.identify.config",
+            "jaxcelt.identify.options",
             "jaxcelt.physics.state",
             "jaxcelt.identify.problem",
             "jaxcelt.identify.result",

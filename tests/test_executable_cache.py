@@ -112,14 +112,14 @@ def test_second_process_loads_the_fit_program(tmp_path):
         import numpy as np
         import jaxcelt as jc
         from jaxcelt import _executable_cache as ec
-        from jaxcelt.identify.config import FitConfig
+        from jaxcelt.identify.options import FitOptions
         from jaxcelt.identify.problem import build_problem
         from jaxcelt.identify.program import evaluate
         from jaxcelt.identify.records import generate_data
         p = jc.CeltParams.paper()
         y0 = jc.initial_state(p, omega=(0.0, 0.0, 5.0), n=(0.17, 0.0, 0.985), normalize=True)
         data = generate_data(p, y0, 0.1, rate=50, kinds=("omega",))
-        prob, z = build_problem(data, p, FitConfig(free=("mu", "k_r"), continuity_weight=1.0, max_steps=2000))
+        prob, z = build_problem(data, p, FitOptions(free=("mu", "k_r"), continuity_weight=1.0, max_steps=2000))
         lowered = []
         real = ec.jax.jit
         ec.jax.jit = lambda fn, *a, **k: (lowered.append(1), real(fn, *a, **k))[1]

@@ -17,7 +17,7 @@ import pytest
 import jaxcelt as jc
 from jaxcelt.identify import program
 from jaxcelt.identify.chaos import gradient_norm_vs_window
-from jaxcelt.identify.config import FitConfig
+from jaxcelt.identify.options import FitOptions
 from jaxcelt.identify.problem import build_problem, residuals, value_and_jacobian
 from jaxcelt.identify.records import generate_data, save_data
 from jaxcelt.identify.strategies import multistart, profile_likelihood, random_guesses
@@ -66,7 +66,7 @@ def test_project_state_lands_on_manifold():
 
 @pytest.mark.slow  # its own compilation of the forward-mode Jacobian (~30 s idle, ~2 min loaded)
 def test_jacobian_matches_finite_differences(short_imu):
-    config = FitConfig(free=FREE, continuity_weight=1.0, sim_rtol=1e-10, sim_atol=1e-12, max_steps=100_000)
+    config = FitOptions(free=FREE, continuity_weight=1.0, sim_rtol=1e-10, sim_atol=1e-12, max_steps=100_000)
     prob, z = build_problem(short_imu.subset(["omega"]), PAPER, config)
     zf = z["params"]
     r, J = value_and_jacobian(prob, zf)
@@ -126,7 +126,7 @@ def test_records_in_parallel_equal_one_program(monkeypatch):
     optimised window states (two records, two windows each), also batched as in `multistart`."""
     y0s = [_start(TRUE), jc.initial_state(TRUE, omega=(0.0, 0.0, -3.0), n=(0.1, 0.0, np.sqrt(0.99)))]
     data = generate_data(TRUE, y0s, 0.2, rate=50, kinds=("omega", "accel"), sensor_rotation=[0.05, 0.0, 0.1])
-    config = FitConfig(free=FREE, windows=2, fit_y0=True, sim_rtol=1e-10, sim_atol=1e-12, max_steps=4000,
+    config = FitOptions(free=FREE, windows=2, fit_y0=True, sim_rtol=1e-10, sim_atol=1e-12, max_steps=4000,
                        time_offset=[0.01, -0.02], fit_rotation=True, fit_time_offset=True)  # fmt: skip
     prob, z = build_problem(data, PAPER, config)
     zf = np.asarray(prob.flatten(z))
@@ -253,7 +253,7 @@ def test_gradient_norm_vs_window_matches_reverse_mode(short_imu):
     tr = data.trajectories[0]
     assert T == pytest.approx([tr.ts[20], tr.ts[50]])
     sub = dataclasses.replace(tr, ts=tr.ts[:21], obs={k: v[:21] for k, v in tr.obs.items()})
-    config = FitConfig(free=FREE, window_states="data", continuity_weight=1.0, max_steps=200_000)
+    config = FitOptions(free=FREE, window_states="data", continuity_weight=1.0, max_steps=200_000)
     prob, z = build_problem(jc.MeasuredData((sub,)), PAPER, config, mode="rev")
     ref = float(jnp.linalg.norm(jax.grad(lambda zz: prob.loss(zz))(z)["params"]))
     assert g[0] == pytest.approx(ref, rel=1e-5)

@@ -2,7 +2,7 @@
 
 Entry points:
 
-* `jaxcelt.identify.api`: `fit` (one fit; its options are one `FitConfig`, `jaxcelt.identify.config`).
+* `jaxcelt.identify.api`: `fit` (one fit; its options are one `FitOptions`, `jaxcelt.identify.options`).
 * `jaxcelt.identify.strategies`: `fit_staged` (growing spans), `multistart` with `random_guesses`,
   `profile_likelihood`.
 * `jaxcelt.identify.records`: measured records (`Trajectory`, `MeasuredData`), `generate_data`, the file formats
@@ -18,9 +18,9 @@ against the window length).
 
 from jaxcelt.identify.api import fit
 from jaxcelt.identify.chaos import finite_time_lyapunov, gradient_norm_vs_window
-from jaxcelt.identify.config import LSQ_OPTIMISERS, OPTIMISERS, STEPS_PER_SECOND, FitConfig
 from jaxcelt.identify.observe import OBSERVABLES, SENSOR_KINDS, observe, rotation_matrix, specific_force
 from jaxcelt.identify.optimisers import DampedGaussNewton
+from jaxcelt.identify.options import LSQ_OPTIMISERS, OPTIMISERS, STEPS_PER_SECOND, FitOptions
 from jaxcelt.identify.problem import STATE_SCALE, TIME_OFFSET_SCALE
 from jaxcelt.identify.records import (
     CSV_COLUMNS,
@@ -39,7 +39,7 @@ from jaxcelt.identify.transforms import DEFAULT_TRANSFORMS, Affine, Bounded, Pos
 
 __all__ = [
     "fit",
-    "FitConfig",
+    "FitOptions",
     "FitResult",
     "predict",
     "fit_staged",

@@ -1,7 +1,7 @@
 """`fit`: gradient-based identification of model parameters from measured trajectories.
 
 A fit builds the least-squares problem (`jaxcelt.identify.problem`) of the records and the configuration
-(`jaxcelt.identify.config.FitConfig`), iterates an optimiser (`jaxcelt.identify.optimisers`) whose residuals and
+(`jaxcelt.identify.options.FitOptions`), iterates an optimiser (`jaxcelt.identify.optimisers`) whose residuals and
 forward-mode Jacobians come from one compiled evaluation program (`jaxcelt.identify.program`), and reports the
 optimum with its Gauss-Newton uncertainty (`jaxcelt.identify.result.FitResult`). A fit keeps no state between calls:
 fits of different data may run at the same time in different threads. Strategies built on it (growing spans,
@@ -17,8 +17,8 @@ from typing import Any
 import numpy as np
 
 from jaxcelt import _config  # noqa: F401
-from jaxcelt.identify.config import FitConfig
 from jaxcelt.identify.optimisers import run
+from jaxcelt.identify.options import FitOptions
 from jaxcelt.identify.problem import Problem, build_problem
 from jaxcelt.identify.program import evaluate
 from jaxcelt.identify.records import MeasuredData
@@ -55,8 +55,7 @@ def fit(
     uncertainty: bool = True,
     max_time: float | None = None,
     callback: Callable[[int, float, dict[str, float]], None] | None = None,
-    config: FitConfig | None = None,
-    options: FitConfig | None = None,
+    options: FitOptions | None = None,
 ) -> FitResult:
     """Fit the free parameters to measured trajectories.
 
@@ -67,27 +66,25 @@ def fit(
         free, optimiser, weights, transforms, windows, window_states, fit_y0, sensor_rotation, fit_rotation,
             time_offset, fit_time_offset, continuity_weight, max_iter, rtol, atol, sim_rtol, sim_atol, max_steps,
             learning_rate, gtol, uncertainty, max_time, callback: the fields of
-            `jaxcelt.identify.config.FitConfig`, documented there (same defaults).
-        config: the whole configuration as one `FitConfig` instead of the keywords (``options`` is another name
-            for it). Passing it together with any keyword that differs from its default is a ValueError.
+            `jaxcelt.identify.options.FitOptions`, documented there (same defaults).
+        options: the whole configuration as one `FitOptions`; a keyword that differs from its default overrides
+            that field of it.
 
     Returns:
         `FitResult`.
     """
-    keywords = {k: v for k, v in locals().items() if k not in ("data", "params0", "config", "options")}
-    if config is not None and options is not None:
-        raise ValueError("fit: pass config= or options= (the same thing), not both")
-    return fit_with(data, params0, FitConfig.from_keywords(keywords, config if config is not None else options))
+    keywords = {k: v for k, v in locals().items() if k not in ("data", "params0", "options")}
+    return fit_with(data, params0, FitOptions.from_keywords(keywords, options))
 
 
-def prepare(data: MeasuredData, params0: CeltParams, config: FitConfig) -> tuple[Problem, np.ndarray]:
+def prepare(data: MeasuredData, params0: CeltParams, config: FitOptions) -> tuple[Problem, np.ndarray]:
     """The problem of a fit and its flat starting unknowns z."""
     prob, z = build_problem(data, params0, config)
     return prob, prob.flatten(z)
 
 
-def fit_with(data: MeasuredData, params0: CeltParams, config: FitConfig) -> FitResult:
-    """`fit` with its configuration as one `FitConfig`."""
+def fit_with(data: MeasuredData, params0: CeltParams, config: FitOptions) -> FitResult:
+    """`fit` with its configuration as one `FitOptions`."""
     prob, zf = prepare(data, params0, config)
     t_start = time.perf_counter()
     trace = run(prob, zf, config, t_start)

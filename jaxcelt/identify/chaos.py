@@ -16,8 +16,8 @@ import numpy as np
 
 from jaxcelt import _config  # noqa: F401
 from jaxcelt._types import State
-from jaxcelt.identify.config import FitConfig
 from jaxcelt.identify.observe import OBSERVABLES
+from jaxcelt.identify.options import FitOptions
 from jaxcelt.identify.problem import STATE_SCALE, build_problem, value_and_jacobian
 from jaxcelt.identify.records import MeasuredData
 from jaxcelt.integrate.solve import simulate
@@ -72,7 +72,7 @@ def gradient_norm_vs_window(
     """
     tr = data.trajectories[0]
     sub = MeasuredData((tr,), getattr(data, "meta", {}))
-    config = FitConfig(
+    config = FitOptions(
         free=tuple(free), windows=1, window_states="data", continuity_weight=1.0,
         sim_rtol=sim_rtol, sim_atol=sim_atol, max_steps=max_steps,
     )  # fmt: skip

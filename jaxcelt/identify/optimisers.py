@@ -27,7 +27,7 @@ import optimistix as optx
 
 from jaxcelt import _config  # noqa: F401
 from jaxcelt._types import Array
-from jaxcelt.identify.config import LSQ_OPTIMISERS, FitConfig
+from jaxcelt.identify.options import LSQ_OPTIMISERS, FitOptions
 from jaxcelt.identify.problem import Problem, theta_and_jacobian, thetas, to_device
 from jaxcelt.identify.program import callback_value_and_jacobian, prefetch
 
@@ -154,11 +154,11 @@ class Trace:
     iter_marks: list[float]
 
 
-def _deadline(config: FitConfig, t_start: float, now: float) -> bool:
+def _deadline(config: FitOptions, t_start: float, now: float) -> bool:
     return config.max_time is not None and now - t_start > config.max_time
 
 
-def run(prob: Problem, zf: Array, config: FitConfig, t_start: float) -> Trace:
+def run(prob: Problem, zf: Array, config: FitOptions, t_start: float) -> Trace:
     """Iterate ``config.optimiser`` from the flat unknowns ``zf`` until it converges or ``config.max_iter``
     or ``config.max_time`` (counted from ``t_start``) is spent; ``config.callback`` after every iteration."""
     free, callback = prob.free, config.callback
@@ -222,7 +222,7 @@ def run(prob: Problem, zf: Array, config: FitConfig, t_start: float) -> Trace:
     return Trace(np.asarray(zf), loss_hist, par_hist, converged, iter_marks)
 
 
-def run_batch(prob: Problem, starts: np.ndarray, config: FitConfig, t_start: float) -> list[Trace]:
+def run_batch(prob: Problem, starts: np.ndarray, config: FitOptions, t_start: float) -> list[Trace]:
     """Iterate the least-squares optimiser ``config.optimiser`` from every start (S, n) at once: one vmapped step
     per iteration, the solves of all starts in one vmapped evaluation; a start that has terminated keeps its iterate
     while the others go on. ``config.callback`` receives the lowest loss over the starts. The starts share

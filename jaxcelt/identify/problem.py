@@ -21,7 +21,7 @@ chaotic records (`jaxcelt.identify.chaos`).
 
 `Problem` is an equinox Module: a pytree whose arrays are the data and whose static fields are the shape of the
 problem, so that one compiled program serves every fit of the same shape. `build_problem` makes it from measured
-records, starting parameters and a `jaxcelt.identify.config.FitConfig`.
+records, starting parameters and a `jaxcelt.identify.options.FitOptions`.
 """
 
 from __future__ import annotations
@@ -38,8 +38,8 @@ import numpy as np
 
 from jaxcelt import _config  # noqa: F401
 from jaxcelt._types import Array
-from jaxcelt.identify.config import FitConfig
 from jaxcelt.identify.observe import OBSERVABLES, SENSOR_KINDS, observe, rotation_matrix
+from jaxcelt.identify.options import FitOptions
 from jaxcelt.identify.records import MeasuredData
 from jaxcelt.identify.transforms import transform_of
 from jaxcelt.integrate.solve import simulate
@@ -277,7 +277,7 @@ def to_device(x) -> Array:
 
 
 def build_problem(
-    data: MeasuredData, params0: CeltParams, config: FitConfig, *, mode: str = "fwd"
+    data: MeasuredData, params0: CeltParams, config: FitOptions, *, mode: str = "fwd"
 ) -> tuple[Problem, dict]:
     """The problem of fitting ``params0``'s free parameters (``config.free``) to ``data``, and its starting
     unknowns z (a dict: "params", "rotation", "offsets", "states"; all zero but the window states).

@@ -16,9 +16,9 @@ import jax
 import numpy as np
 
 from jaxcelt import _config  # noqa: F401
-from jaxcelt.identify.config import FitConfig
 from jaxcelt.identify.observe import OBSERVABLES, SENSOR_KINDS, observe, rotation_matrix
 from jaxcelt.identify.optimisers import Trace
+from jaxcelt.identify.options import FitOptions
 from jaxcelt.identify.problem import TIME_OFFSET_SCALE, Problem, theta_and_jacobian, to_device
 from jaxcelt.physics.params import CeltParams
 
@@ -134,7 +134,7 @@ def split_times(iter_marks: list[float]) -> tuple[float, float]:
 
 
 def make_result(
-    prob: Problem, trace: Trace, r: np.ndarray, Jflat: np.ndarray, config: FitConfig, t_start: float
+    prob: Problem, trace: Trace, r: np.ndarray, Jflat: np.ndarray, config: FitOptions, t_start: float
 ) -> FitResult:
     """`FitResult` at the final unknowns ``trace.zf`` with residuals ``r`` and Jacobian ``Jflat`` there; the times
     from ``trace.iter_marks`` (`split_times`) and ``t_start`` (the start of the fit)."""

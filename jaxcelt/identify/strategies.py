@@ -1,8 +1,8 @@
 """Fitting strategies built on `jaxcelt.identify.api.fit`: growing spans (`fit_staged`), several starts
 (`multistart`, with `random_guesses`), and the profile likelihood of one parameter (`profile_likelihood`).
 
-Each takes the fit's configuration as `fit`'s keywords (``**fit_kw``), which may include ``config=FitConfig(...)``;
-keywords given with a config override its fields.
+Each takes the fit's configuration as `fit`'s keywords (``**fit_kw``), which may include ``options=FitOptions(...)``;
+keywords given with it override its fields.
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ import numpy as np
 
 from jaxcelt import _config  # noqa: F401
 from jaxcelt.identify.api import fit_with, prepare
-from jaxcelt.identify.config import LSQ_OPTIMISERS, NOT_FREE, FitConfig
 from jaxcelt.identify.optimisers import run_batch
+from jaxcelt.identify.options import LSQ_OPTIMISERS, NOT_FREE, FitOptions
 from jaxcelt.identify.problem import STATE_SCALE
 from jaxcelt.identify.program import evaluate
 from jaxcelt.identify.records import MeasuredData
@@ -31,16 +31,15 @@ from jaxcelt.physics.state import project_state
 __all__ = ["fit_staged", "multistart", "random_guesses", "profile_likelihood"]
 
 
-def config_of(fit_kw: dict[str, Any]) -> FitConfig:
-    """The `FitConfig` of `fit`'s keywords ``fit_kw``: ``config`` (or ``options``) if given, with the other
-    keywords replacing its fields."""
+def config_of(fit_kw: dict[str, Any]) -> FitOptions:
+    """The `FitOptions` of `fit`'s keywords ``fit_kw``: ``options`` if given, with the other keywords replacing its
+    fields."""
     kw = dict(fit_kw)
-    base = kw.pop("config", None)
-    base = kw.pop("options", None) if base is None else base
+    base = kw.pop("options", None)
     if base is None:
-        return FitConfig(**kw)
-    if not isinstance(base, FitConfig):
-        raise ValueError(f"config must be a FitConfig, got {type(base).__name__}")
+        return FitOptions(**kw)
+    if not isinstance(base, FitOptions):
+        raise ValueError(f"options must be a FitOptions, got {type(base).__name__}")
     return base.replace(**kw) if kw else base
 
 
@@ -172,7 +171,7 @@ def random_guesses(
 
 
 def _fit_batch(
-    data: MeasuredData, params0: CeltParams, guesses: Sequence[dict[str, float]], config: FitConfig
+    data: MeasuredData, params0: CeltParams, guesses: Sequence[dict[str, float]], config: FitOptions
 ) -> list[FitResult]:
     """Least-squares fits from every guess at once (see `multistart`)."""
     prob, zf0 = prepare(data, params0, config)

@@ -7,7 +7,7 @@ A fit optimises z, not theta. Each free parameter has a transform with ``forward
 * `Bounded(lo, hi)`: a scaled logistic, lo < theta < hi,
 * `Affine(scale)`: theta = theta0 + scale z, for signed parameters.
 
-`DEFAULT_TRANSFORMS` names the transform of each parameter that is not `Positive`; `jaxcelt.identify.config.FitConfig`
+`DEFAULT_TRANSFORMS` names the transform of each parameter that is not `Positive`; `jaxcelt.identify.options.FitOptions`
 ``transforms`` overrides it per parameter.
 """
 

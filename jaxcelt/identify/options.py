@@ -1,9 +1,9 @@
-"""The options of a fit: one frozen, keyword-only object, `FitConfig`, checked once when it is made.
+"""The options of a fit: one frozen, keyword-only object, `FitOptions`, checked once when it is made.
 
 `jaxcelt.identify.api.fit` accepts every field as a keyword (``fit(data, params0, free=..., windows=4)``) or the
-whole object (``fit(data, params0, config=FitConfig(...))``); the strategies (`jaxcelt.identify.strategies`) and the
-problem builder (`jaxcelt.identify.problem.build_problem`) take the object, never long argument lists. A config
-holds no data and no starting values: the same config fits any records from any start.
+whole object (``fit(data, params0, options=FitOptions(...))``); the strategies (`jaxcelt.identify.strategies`) and the
+problem builder (`jaxcelt.identify.problem.build_problem`) take the object, never long argument lists. The options
+hold no data and no starting values: the same options fit any records from any start.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import numpy as np
 
 from jaxcelt.physics.params import PARAM_NAMES
 
-__all__ = ["FitConfig", "OPTIMISERS", "LSQ_OPTIMISERS", "STEPS_PER_SECOND", "NOT_FREE"]
+__all__ = ["FitOptions", "OPTIMISERS", "LSQ_OPTIMISERS", "STEPS_PER_SECOND", "NOT_FREE"]
 
 OPTIMISERS = ("lm", "gn", "gn-damped", "adam", "lbfgs")
 """Optimiser names: optimistix least squares (``lm``, ``gn``, ``gn-damped``), optax (``adam``, ``lbfgs``)."""
@@ -34,7 +34,7 @@ NOT_FREE = ("v_pi_sign", "derivative_exact", "omega_pi", "q_pi")
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
-class FitConfig:
+class FitOptions:
     """Everything that configures a fit (the data and the starting parameters are arguments of `fit`).
 
     Attributes:
@@ -124,7 +124,7 @@ class FitConfig:
         if self.window_states not in ("data", "optimise"):
             raise ValueError(f"fit: window_states must be 'data' or 'optimise', got {self.window_states!r}")
 
-    def replace(self, **changes) -> FitConfig:
+    def replace(self, **changes) -> FitOptions:
         """A copy with ``changes`` (checked again)."""
         return dataclasses.replace(self, **changes)
 
@@ -137,18 +137,17 @@ class FitConfig:
         return int(STEPS_PER_SECOND * max(1.0, np.ceil(span)))
 
     @classmethod
-    def from_keywords(cls, keywords: dict[str, Any], config: FitConfig | None) -> FitConfig:
-        """The config of a call given ``keywords`` (name -> value, every field) and perhaps a ``config``:
-        the keywords alone, or the config alone when every keyword has its default value."""
-        if config is None:
+    def from_keywords(cls, keywords: dict[str, Any], options: FitOptions | None) -> FitOptions:
+        """The options of a call given ``keywords`` (name -> value, every field) and perhaps ``options``: the
+        keywords alone, or ``options`` with each keyword that differs from its default overriding that field (the
+        rule of every options object in jaxcelt)."""
+        if options is None:
             return cls(**keywords)
-        if not isinstance(config, FitConfig):
-            raise ValueError(f"fit: config must be a FitConfig, got {type(config).__name__}")
+        if not isinstance(options, FitOptions):
+            raise ValueError(f"fit: options must be a FitOptions, got {type(options).__name__}")
         defaults = {f.name: f.default for f in dataclasses.fields(cls)}
-        given = [n for n, v in keywords.items() if not _is_default(v, defaults[n])]
-        if given:
-            raise ValueError(f"fit: pass either config= or the keywords {given}, not both")
-        return config
+        given = {n: v for n, v in keywords.items() if not _is_default(v, defaults[n])}
+        return options.replace(**given) if given else options
 
 
 def _is_default(value: Any, default: Any) -> bool:
