@@ -16,6 +16,8 @@ from types import MappingProxyType
 
 __all__ = ["MOVED", "RENAMED", "install"]
 
+_MISSING = object()
+
 MOVED: Mapping[str, tuple[str, ...]] = MappingProxyType(
     {
         # old module (under jaxcelt.)  -> new modules searched in order for a name
@@ -70,6 +72,20 @@ RENAMED: Mapping[str, Mapping[str, str]] = MappingProxyType(
     {
         "ladder": MappingProxyType({"OBSERVABLES": "jaxcelt.studies.ladder:QUANTITIES"}),
         "benchmarking": MappingProxyType({"Scene": "jaxcelt.studies.benchmarking:BenchmarkScene"}),
+        "orbit_continuation": MappingProxyType(
+            {
+                "OrbitBranch": "jaxcelt.orbits.branch:NaturalBranch",
+                "continue_periodic_orbit": "jaxcelt.orbits.branch:continue_natural",
+                "continue_pseudo_arclength": "jaxcelt.orbits.branch:continue_arclength",
+            }
+        ),
+        "sweep": MappingProxyType(
+            {
+                "orbit": "jaxcelt.sweeps.dense:dense_trajectory",
+                "prepare_orbit": "jaxcelt.sweeps.dense:prepare_dense_trajectory",
+                "continuation": "jaxcelt.sweeps.following:follow_attractor",
+            }
+        ),
     }
 )
 """Old module name -> {old name: "new.module:new_name"} for names that were renamed as they moved."""
@@ -87,14 +103,17 @@ def _stand_in(package: str, old: str, targets: tuple[str, ...]) -> types.ModuleT
         found += [(t, attr) for t in targets if not renamed]
         for target, new_attr in found:
             mod = importlib.import_module(target)
-            if hasattr(mod, new_attr):
+            with warnings.catch_warnings():  # a deprecated alias at the new place: this warning is the one
+                warnings.simplefilter("ignore", DeprecationWarning)
+                value = getattr(mod, new_attr, _MISSING)
+            if value is not _MISSING:
                 public = " (or jaxcelt." + new_attr + ")" if new_attr in getattr(sys.modules[package], "__all__", ()) else ""
                 warnings.warn(
                     f"{name} is deprecated and will be removed in the next release; use {target}.{new_attr}{public}",
                     DeprecationWarning,
                     stacklevel=2,
                 )
-                return getattr(mod, new_attr)
+                return value
         raise AttributeError(f"module {name!r} has no attribute {attr!r} (it moved to {', '.join(targets)})")
 
     module.__getattr__ = __getattr__  # type: ignore[method-assign]

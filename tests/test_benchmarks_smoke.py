@@ -84,13 +84,14 @@ def test_mujoco_stone_matches_params_and_spin_decay():
     import mujoco_peer as mp
 
     import jaxcelt as jc
+    from jaxcelt.physics.params import inertia_tensor
 
     p = jc.CeltParams.paper(q_pi=0.0)
     m = mujoco.MjModel.from_xml_string(mp.mjcf(p))
     # same mass and the same inertia tensor (MuJoCo stores its principal moments): eigenvalues
     # agree to round-off of the XML's decimal numbers; without B12 they would differ by up to 11 %
     assert abs(m.body_mass[1] - float(p.m)) < 1e-12
-    eig = np.sort(np.linalg.eigvalsh(np.asarray(jc.params.inertia_tensor(p))))
+    eig = np.sort(np.linalg.eigvalsh(np.asarray(inertia_tensor(p))))
     assert np.allclose(np.sort(m.body_inertia[1]), eig, rtol=1e-9, atol=0)
     # pure spin on a fixed table: the torsional coefficient is the paper's pure-spin moment per unit
     # N, so spin decays at mu a_hat 4 E S2 m g / B3 = 2.5176 rad/s^2 in both models. Observed: MuJoCo

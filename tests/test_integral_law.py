@@ -15,6 +15,7 @@ from jaxcelt.physics.contact.integral import (
     patch_integrals,
     profile_moments,
 )
+from jaxcelt.physics.contact.laws import ContactKinematics
 
 B = 0.1813
 _pi = jax.jit(patch_integrals, static_argnames=("profile", "n_angle", "n_radial"))
@@ -125,7 +126,7 @@ def test_gradient_safe_at_rest():
     ex, ey, n = jnp.eye(3)
 
     def loads(x):
-        kin = jc.contact.ContactKinematics(*x)
+        kin = ContactKinematics(*x)
         L = law.loads(kin, ex, ey, n, p)
         return jnp.concatenate([L.t, L.m_s, L.m_r])
 

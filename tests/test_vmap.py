@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 
 import jaxcelt as jc
-import jaxcelt.integrate.solve as jsolve
+import jaxcelt.physics.model as jmodel
+from jaxcelt.integrate.solve import _fill_implicit_tols
 
 B = 64
 T1 = 0.3
@@ -77,14 +78,14 @@ def test_no_retrace_on_new_values(monkeypatch):
     y0 = jc.initial_state(p)
     ts = jnp.linspace(0.0, 0.2, 7)  # a shape no other test uses, so the first call below traces
     counting = eqx.debug.assert_max_traces(jc.vector_field, max_traces=None)
-    monkeypatch.setattr(jsolve, "vector_field", counting)
+    monkeypatch.setattr(jmodel, "vector_field", counting)
     jc.simulate(p, y0, 0.2, ts=ts)
     assert eqx.debug.get_num_traces(counting) > 0  # the detector sees the trace
     # dt0=None vs a given dt0 is a change of structure (one more compilation, by design)
     jc.simulate(p, y0, 0.2, ts=ts, dt0=1e-3)
 
     # from now on any trace of the simulate path raises
-    monkeypatch.setattr(jsolve, "vector_field", eqx.debug.assert_max_traces(jc.vector_field, max_traces=0))
+    monkeypatch.setattr(jmodel, "vector_field", eqx.debug.assert_max_traces(jc.vector_field, max_traces=0))
     p2 = p.replace(mu=0.31, k_r=0.2, omega_pi=15.6, b_Ts=0.7, m_Ts=1.1, q_pi=0.03, v_pi_sign=-1.0)
     y2 = jc.initial_state(p2, omega=(0.1, -0.2, 1.0), n=(0.05, 0.0, float(np.sqrt(1 - 0.05**2))), psi=0.3)
     for kwargs in (
@@ -114,7 +115,7 @@ def test_no_retrace_on_new_values(monkeypatch):
 def test_implicit_solver_tolerances_filled():
     """Cheap check (no compilation): diffeqsolve cannot reach through MonitoredSolver to give the
     implicit solver's root finder the step-size controller's tolerances, so simulate fills them."""
-    solver = jsolve._fill_implicit_tols(diffrax.Kvaerno5(), 1e-9, 1e-11)
+    solver = _fill_implicit_tols(diffrax.Kvaerno5(), 1e-9, 1e-11)
     rf = solver.root_finder
     assert float(rf.rtol) == 1e-9 and float(rf.atol) == 1e-11
 
