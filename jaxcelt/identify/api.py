@@ -63,12 +63,10 @@ def fit(
         data: `jaxcelt.identify.records.MeasuredData` (any observation kinds; several records, each with its
             own omega_pi, q_pi).
         params0: starting parameters (also the values of every parameter that is not free).
-        free, optimiser, weights, transforms, windows, window_states, fit_y0, sensor_rotation, fit_rotation,
-            time_offset, fit_time_offset, continuity_weight, max_iter, rtol, atol, sim_rtol, sim_atol, max_steps,
-            learning_rate, gtol, uncertainty, max_time, callback: the fields of
-            `jaxcelt.identify.options.FitOptions`, documented there (same defaults).
-        options: the whole configuration as one `FitOptions`; a keyword that differs from its default overrides
-            that field of it.
+        options: the whole configuration as one `jaxcelt.FitOptions`; a keyword that differs from its default
+            overrides that field of it.
+        **keywords: every other parameter (``free``, ``optimiser``, ``weights``, ``windows``, ``max_iter``, ...)
+            is a field of `jaxcelt.FitOptions`, documented there, with the same default.
 
     Returns:
         `FitResult`.
