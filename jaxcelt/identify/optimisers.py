@@ -14,7 +14,6 @@ per iteration). Both return a `Trace`: the final unknowns and the per-iteration 
 from __future__ import annotations
 
 import dataclasses
-import threading
 import time
 from collections.abc import Callable
 
@@ -29,16 +28,9 @@ from jaxcelt import _config  # noqa: F401
 from jaxcelt._types import Array
 from jaxcelt.identify.options import LSQ_OPTIMISERS, FitOptions
 from jaxcelt.identify.problem import Problem, theta_and_jacobian, thetas, to_device
-from jaxcelt.identify.program import callback_value_and_jacobian, prefetch
+from jaxcelt.identify.program import callback_value_and_jacobian, evaluating, prefetch
 
 __all__ = ["DampedGaussNewton", "Trace", "run", "run_batch", "lsq_solver"]
-
-_STEP_LOCK = threading.Lock()
-"""Held while an optimiser program runs (from its call until its result is ready): a program waiting in the
-evaluation callback holds one of the backend's execution threads, and two of them at once can leave none for the
-evaluation programs they wait for (seen on a 2-core CPU). Fits in several threads take turns step by step; their
-host work between steps overlaps."""
-
 
 @jax.custom_jvp
 def _residuals(zf: Array, prob: Problem) -> Array:
@@ -173,10 +165,10 @@ def run(prob: Problem, zf: Array, config: FitOptions, t_start: float) -> Trace:
     if config.optimiser in LSQ_OPTIMISERS:
         solver = lsq_solver(config.optimiser, config.rtol, config.atol)
         prefetch(prob, zf)
-        with _STEP_LOCK:
+        with evaluating(prob):
             state = jax.block_until_ready(_lsq_init(zf, solver, prob))
         for it in range(config.max_iter):
-            with _STEP_LOCK:
+            with evaluating(prob):
                 z_new, state, loss_acc, done, ok = jax.block_until_ready(_lsq_step(zf, state, solver, prob))
             iter_marks.append(time.perf_counter())
             zf = z_new
@@ -200,7 +192,7 @@ def run(prob: Problem, zf: Array, config: FitOptions, t_start: float) -> Trace:
         opt_state = opt.init(zf)
         g0 = None
         for it in range(config.max_iter):
-            with _STEP_LOCK:
+            with evaluating(prob):
                 step = _optax_step(zf, opt_state, opt, prob, config.optimiser == "lbfgs")
                 z_new, opt_state, value, gnorm = jax.block_until_ready(step)
             iter_marks.append(time.perf_counter())
@@ -232,14 +224,14 @@ def run_batch(prob: Problem, starts: np.ndarray, config: FitOptions, t_start: fl
     zs = to_device(starts)
     solver = lsq_solver(config.optimiser, config.rtol, config.atol)
     prefetch(prob, starts)
-    with _STEP_LOCK:
+    with evaluating(prob):
         states = jax.block_until_ready(_lsq_init_batch(zs, solver, prob))
     frozen, converged = np.zeros(S, bool), np.zeros(S, bool)
     loss_hist: list[list[float]] = [[] for _ in range(S)]
     par_hist: list[list[dict]] = [[] for _ in range(S)]
     iter_marks = [time.perf_counter()]
     for it in range(config.max_iter):
-        with _STEP_LOCK:
+        with evaluating(prob):
             step = _lsq_step_batch(zs, states, jax.device_put(frozen), solver, prob)
             zs, states, loss, done, ok = jax.block_until_ready(step)
         iter_marks.append(time.perf_counter())
