@@ -236,9 +236,14 @@ def _store_for(key: str, exe: Any) -> None:
 def _store(path: Path, exe: Any) -> None:
     from jax.experimental import serialize_executable
 
-    tmp = None
     try:
         blob = pickle.dumps(serialize_executable.serialize(exe))
+    except Exception:  # noqa: BLE001
+        # A program with a host callback (a progress bar, an error check) cannot be serialised: it is simply not
+        # stored, and a later process compiles it as it would without this cache. Nothing for the user to act on.
+        return
+    tmp = None
+    try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
         with os.fdopen(fd, "wb") as fh:
@@ -247,7 +252,7 @@ def _store(path: Path, exe: Any) -> None:
             os.fsync(fh.fileno())
         os.replace(tmp, path)
         tmp = None
-    except Exception as e:  # an unwritable directory or a program that cannot be serialised
+    except OSError as e:  # an unwritable or full directory: worth saying, the cache does not work
         warnings.warn(f"jaxcelt: could not store executable {path.name} ({type(e).__name__}: {e})", stacklevel=3)
     finally:
         if tmp is not None and os.path.exists(tmp):

@@ -5,6 +5,7 @@ program, and a damaged file is recompiled with a warning instead of crashing."""
 import subprocess
 import sys
 import textwrap
+import warnings
 
 import jax
 import jax.numpy as jnp
@@ -215,3 +216,31 @@ def test_deferred_compilation_starts_when_asked_for(cache, monkeypatch, ask):
     with pytest.raises(TypeError, match="broken program"):
         ec.compiled("u", bad, args, "bad")
     assert not any(k.startswith("u-") for k in ec._MEMORY)
+
+
+def test_program_with_a_host_callback_is_not_stored_and_says_nothing(cache):
+    # such a program cannot be serialised (its callback is a local Python object): it is compiled and run as usual,
+    # nothing is written, and no warning reaches the user (README command 1 used to print one mid progress bar)
+    def host(x):
+        return np.asarray(x) + 1.0
+
+    def f(leaves, x):
+        return jax.pure_callback(host, jax.ShapeDtypeStruct(x.shape, x.dtype), x) * leaves[0]
+
+    args = _args()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = ec.compiled("cb", f, args, "callback")(*args)
+    np.testing.assert_allclose(np.asarray(out), (np.linspace(0.0, 1.0, 3) + 1.0) * 2.0, rtol=0, atol=1e-15)
+    assert list(cache.glob("*.bin")) == []
+
+
+def test_unwritable_directory_is_reported(cache, monkeypatch):
+    # a directory that cannot be written is worth a warning: the cache does not work there
+    def refuse(*a, **k):
+        raise PermissionError("read-only file system")
+
+    monkeypatch.setattr(ec.tempfile, "mkstemp", refuse)
+    args = _args()
+    with pytest.warns(UserWarning, match="could not store executable .*PermissionError"):
+        ec.compiled("t", _f, args, "sin-unwritable")(*args)
