@@ -167,8 +167,10 @@ def test_bifurcation_solver_option(tmp_path):
     p = jc.CeltParams.paper()
     r = jc.bifurcation(p, [14.0, 17.0], transient_periods=1, sample_periods=2, solver=diffrax.Dopri5(),
                        stop_on_invalid=True)  # fmt: skip
+    # the CLI (one host device) and this process (two) compile two programs: samples to rounding,
+    # step counts within 1 % (measured: equal)
     np.testing.assert_allclose(ds["section"].values, r.samples, rtol=0, atol=1e-10)
-    np.testing.assert_array_equal(ds["num_steps"].values, r.num_steps)
+    assert np.all(np.abs(ds["num_steps"].values - r.num_steps) <= np.maximum(2, 0.01 * r.num_steps))
 
 
 def test_bifurcation_rejects_unknown_solver(capsys):

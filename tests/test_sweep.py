@@ -12,7 +12,7 @@ import textwrap
 import jax
 import numpy as np
 import pytest
-from _sweep_common import KW, SAMPLE_ATOL, VALUES, assert_same_lanes
+from _sweep_common import KW, SAMPLE_ATOL, VALUES, assert_same_lanes, assert_steps_close
 
 import jaxcelt as jc
 from jaxcelt.commands.args import parse_range
@@ -104,7 +104,7 @@ def test_failing_lane_is_isolated(base, paper_params):
     assert out["status"][2] == 1  # max_steps reached
     assert np.all(out["status"][[0, 1, 3]] == 0)
     for i in (0, 1, 3):
-        assert out["num_steps"][i] == base.num_steps[i]
+        assert_steps_close(out["num_steps"][i], base.num_steps[i])
         assert np.isfinite(out["samples"][i]).all()
         np.testing.assert_allclose(out["samples"][i], base.samples[i], rtol=0, atol=SAMPLE_ATOL)
 
@@ -181,8 +181,10 @@ def test_stop_on_invalid_lanes_equal_simulate(base, paper_params):
         ts = r.t_samples[i]
         sol = jc.simulate(p, jc.initial_state(p), ts[-1], ts=ts, exact_ts=True, max_steps=4000, stop_on_invalid=True)
         ys = np.asarray(sol.ys)
+        # simulate and the pool are two compiled programs: the same status and step counts within
+        # STEPS_RTOL (measured: equal), hence the same stopped samples
         assert int(sol.status) == r.status[i]
-        assert int(sol.num_steps) == r.num_steps[i]
+        assert_steps_close(int(sol.num_steps), r.num_steps[i])
         np.testing.assert_array_equal(np.isfinite(ys), np.isfinite(r.samples[i]))
         fin = np.isfinite(ys)
         assert np.max(np.abs(ys[fin] - r.samples[i][fin]), initial=0.0) <= 1e-10
@@ -193,7 +195,7 @@ def test_stop_on_invalid_lanes_equal_simulate(base, paper_params):
     assert r.num_steps[0] < base.num_steps[0]
     # valid lanes: stop_on_invalid compiles another program; same lanes within SAMPLE_ATOL
     np.testing.assert_allclose(r.samples[1:], base.samples[1:], rtol=0, atol=SAMPLE_ATOL)
-    np.testing.assert_array_equal(r.num_steps[1:], base.num_steps[1:])
+    assert_steps_close(r.num_steps[1:], base.num_steps[1:])
 
 
 def _vmapped_simulate(params, values, *, transient_periods, sample_periods, rtol, atol, max_steps, **_):
