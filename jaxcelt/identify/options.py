@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from jaxcelt._options import with_keywords
 from jaxcelt.physics.params import PARAM_NAMES
 
 __all__ = ["FitOptions", "OPTIMISERS", "LSQ_OPTIMISERS", "STEPS_PER_SECOND", "NOT_FREE"]
@@ -143,11 +144,9 @@ class FitOptions:
         rule of every options object in jaxcelt)."""
         if options is None:
             return cls(**keywords)
-        if not isinstance(options, FitOptions):
-            raise ValueError(f"fit: options must be a FitOptions, got {type(options).__name__}")
         defaults = {f.name: f.default for f in dataclasses.fields(cls)}
         given = {n: v for n, v in keywords.items() if not _is_default(v, defaults[n])}
-        return options.replace(**given) if given else options
+        return with_keywords(cls, options, options, given, caller="fit")
 
 
 def _is_default(value: Any, default: Any) -> bool:

@@ -317,7 +317,7 @@ def continue_arclength(
     Returns:
         `ArclengthBranch` (host arrays; ``y`` are states, ``tangents`` in the chart of each point).
     """
-    opts = resolve_options(options, ARCLENGTH_DEFAULTS, **settings)
+    opts = resolve_options(options, ARCLENGTH_DEFAULTS, caller="continue_arclength", **settings)
     window = None
     if np.ndim(lam_end) == 1:
         window = tuple(float(x) for x in lam_end)

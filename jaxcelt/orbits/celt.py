@@ -248,7 +248,7 @@ def periodic_orbit(
     y_guess = jnp.asarray(y_guess, dtype=float)
     if y_guess.shape != (13,):
         raise ValueError(f"periodic_orbit: 'y_guess' must have shape (13,), got {y_guess.shape}")
-    opts = resolve_options(options, ORBIT_DEFAULTS, **settings)
+    opts = resolve_options(options, ORBIT_DEFAULTS, caller="periodic_orbit", **settings)
     opts = dataclasses.replace(opts, solver=opts.solver or diffrax.Dopri8())
     return _orbit(params, y_guess, jnp.asarray(t0, float), k=k, law=get_contact_law(contact_law), options=opts)
 
@@ -315,7 +315,7 @@ def continue_orbit(
         )
     else:
         stop = float(st)
-    opts = resolve_options(options, BRANCH_DEFAULTS, **settings)
+    opts = resolve_options(options, BRANCH_DEFAULTS, caller="continue_orbit", **settings)
 
     def args_of(lam):
         return eqx.tree_at(lambda p: getattr(p, name), params, jnp.asarray(lam, float))
@@ -382,7 +382,7 @@ def locate_orbit_bifurcation(
     if name in wrt:
         raise ValueError(f"locate_orbit_bifurcation: 'wrt' must not contain the bifurcation parameter {name!r}")
     check_state(y_guess, params, name="y_guess", tol=GUESS_MANIFOLD_TOL)
-    opts = resolve_options(options, POINT_DEFAULTS, **settings)
+    opts = resolve_options(options, POINT_DEFAULTS, caller="locate_orbit_bifurcation", **settings)
     theta = {n: jnp.asarray(getattr(params, n), float) for n in wrt}
 
     def args_of(lam, th):

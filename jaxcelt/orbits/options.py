@@ -24,11 +24,12 @@ from typing import Any, TypedDict
 
 import diffrax
 
+from jaxcelt._options import with_keywords
+
 __all__ = ["ShootingOptions", "ShootingKeywords", "resolve_options"]
 
 _POSITIVE_FLOATS = ("rtol", "atol", "newton_tol")
 _POSITIVE_INTS = ("max_steps", "newton_max_steps")
-_FIELDS = ("solver", "rtol", "atol", "max_steps", "newton_tol", "newton_max_steps")
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
@@ -81,17 +82,13 @@ class ShootingKeywords(TypedDict, total=False):
     newton_max_steps: int
 
 
-def resolve_options(options: ShootingOptions | None, defaults: ShootingOptions, **given: Any) -> ShootingOptions:
+def resolve_options(
+    options: ShootingOptions | None, defaults: ShootingOptions, *, caller: str = "shooting", **given: Any
+) -> ShootingOptions:
     """The options a function runs with: ``options`` (or its ``defaults``), then each keyword not None on top.
 
-    ``given`` are the keywords the caller passed (`ShootingKeywords`; None counts as not given). An unknown
-    keyword is a TypeError naming it.
+    ``given`` are the keywords the caller passed (`ShootingKeywords`; None counts as not given); the rule is
+    `jaxcelt._options.with_keywords` (an unknown keyword is a TypeError naming it).
     """
-    if options is not None and not isinstance(options, ShootingOptions):
-        raise ValueError(f"'options' must be a ShootingOptions, got {type(options).__name__}")
-    base = defaults if options is None else options
-    unknown = sorted(set(given) - set(ShootingKeywords.__annotations__))
-    if unknown:
-        raise TypeError(f"unexpected keyword argument(s) {unknown}; the solver and Newton settings are {_FIELDS}")
     changed = {name: value for name, value in given.items() if value is not None}
-    return dataclasses.replace(base, **changed) if changed else base
+    return with_keywords(ShootingOptions, options, defaults, changed, caller=caller)

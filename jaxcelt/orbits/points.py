@@ -302,7 +302,7 @@ def locate_bifurcation(
     """
     if kind not in BIFURCATION_POINT_KINDS:
         raise ValueError(f"kind must be one of {sorted(BIFURCATION_POINT_KINDS)}, got {kind!r}")
-    opts = resolve_options(options, _DEFAULTS, **settings)
+    opts = resolve_options(options, _DEFAULTS, caller="locate_bifurcation", **settings)
     newton_tol = opts.newton_tol
     shift = BIFURCATION_POINT_KINDS[kind]
     y_guess = jnp.asarray(y_guess, dtype=float)

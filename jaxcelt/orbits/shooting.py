@@ -126,7 +126,7 @@ def stroboscopic_map(
     ``options`` (`ShootingOptions`; its Newton fields are unused) or the keywords ``solver``, ``rtol``
     (default 1e-11), ``atol`` (1e-12), ``max_steps`` (100 000) set the solve (`resolve_options`).
     """
-    opts = resolve_options(options, _DEFAULTS, **settings)
+    opts = resolve_options(options, _DEFAULTS, caller="stroboscopic_map", **settings)
     sol = _flow(vector_field, jnp.asarray(y0), args, period=period, k=k, t0=t0, options=opts, forward_mode=True)
     return sol.ys[-1], sol.result == diffrax.RESULTS.successful, sol.stats["num_steps"]
 
@@ -151,7 +151,7 @@ def variational_map(
     does not see the tangent dynamics (e.g. at an equilibrium y = 0, where steps grow unbounded).
     Options as in `stroboscopic_map`.
     """
-    opts = resolve_options(options, _DEFAULTS, **settings)
+    opts = resolve_options(options, _DEFAULTS, caller="variational_map", **settings)
     y0 = jnp.asarray(y0)
 
     def field(t, state, a):
@@ -241,7 +241,7 @@ def find_periodic_orbit(
         at most ``newton_tol`` (x10 slack) and the final solve succeeded; a solver failure
         anywhere gives 2, otherwise 1.
     """
-    opts = resolve_options(options, _DEFAULTS, **settings)
+    opts = resolve_options(options, _DEFAULTS, caller="find_periodic_orbit", **settings)
     y_guess = jnp.asarray(y_guess)
     embed, chart = identity_charts(embed, chart)
     z0 = chart(y_guess, y_guess, args)

@@ -48,7 +48,7 @@ def switch_at_period_doubling(
     if bifurcation.kind != "period-doubling":
         raise ValueError(f"bifurcation: expected a period-doubling, got {bifurcation.kind!r}")
     single = {key: find_kw.pop(key, None) for key in ("solver", "rtol", "atol", "max_steps")}
-    opts = resolve_options(options, ShootingOptions(), **single)
+    opts = resolve_options(options, ShootingOptions(), caller="switch_at_period_doubling", **single)
     ode = dict(t0=find_kw.get("t0", 0.0), options=opts)
     args_pd = args_of(jnp.asarray(bifurcation.value))
     y_pd = jnp.asarray(bifurcation.y)

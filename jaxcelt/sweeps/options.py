@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from jaxcelt._options import with_keywords
 from jaxcelt.ensemble.config import SweepConfig
 from jaxcelt.integrate.solve import DEFAULT_SOLVER
 
@@ -112,9 +113,6 @@ class SweepOptions:
         )
 
 
-_FIELDS = frozenset(f.name for f in dataclasses.fields(SweepOptions))
-
-
 def resolve_options(
     options: SweepOptions | None,
     keywords: Mapping[str, Any],
@@ -122,18 +120,9 @@ def resolve_options(
     caller: str,
     defaults: Mapping[str, Any] | None = None,
 ) -> SweepOptions:
-    """The options of a call: ``options`` (or `SweepOptions` with ``defaults``) with ``keywords`` applied.
-
-    TypeError for a keyword that is no field of `SweepOptions` (as Python reports an unknown
-    keyword argument of ``caller``); ValueError if ``options`` is not a `SweepOptions`."""
-    unknown = sorted(set(keywords) - _FIELDS)
-    if unknown:
-        raise TypeError(f"{caller}() got unexpected keyword argument(s) {', '.join(map(repr, unknown))}")
-    if options is None:
-        options = SweepOptions(**dict(defaults or {}))
-    elif not isinstance(options, SweepOptions):
-        raise ValueError(f"'options' must be a SweepOptions, got {type(options).__name__}")
-    return dataclasses.replace(options, **keywords) if keywords else options
+    """The options of a call: ``options`` (or `SweepOptions` with ``defaults``) with ``keywords`` applied
+    (`jaxcelt._options.with_keywords`: TypeError for a keyword that is no field, naming ``caller``)."""
+    return with_keywords(SweepOptions, options, SweepOptions(**dict(defaults or {})), keywords, caller=caller)
 
 
 def _dtype_name(dtype: Any) -> str:
