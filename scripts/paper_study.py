@@ -7,14 +7,21 @@ Everything the text leaves open is swept in one vmapped batch of lanes (`jaxcelt
 the reading switches v_pi_sign and derivative_exact (MODEL.md section 9), the smoothing eps = eps_R,
 initial conditions (rest at several headings psi0, small roll/pitch rocking, slow spin) and the
 transient length; each lane is labelled with `jaxcelt.sweeps.regimes.classify` (section period, largest
-Lyapunov exponent, global drift of O) twice: with the model's validity enforced (n3 <= 0 or
-lift-off -> "invalid") and with motion past n3 <= 0 allowed (labels ignore validity).
+Lyapunov exponent and its standard error, global drift of O) twice: with the model's validity enforced
+(n3 <= 0 or lift-off -> "invalid") and with motion past n3 <= 0 allowed (labels ignore validity).
+
+The labels follow the README's rule (`classify`'s defaults): period-k when the samples repeat; otherwise
+lambda_1 -+ 2 standard errors against 0.02 1/s (chaotic / converging / quasi-periodic / uncertain). Study
+files written before the standard error was stored keep their rows; ``--relabel`` re-labels the stored rows
+of every study file by that rule (the point estimate decides where a row has no standard error, as
+`classify` does) and rewrites their score tables, without integrating anything.
 
 Chunks are cached under --out (an interrupted run resumes). Writes docs/paper-reproduction/*.json
 and the table used by docs/paper-reproduction.md.
 
     python scripts/paper_study.py --quick          # small smoke version
     python scripts/paper_study.py                  # the study (tens of minutes on 2 CPU cores)
+    python scripts/paper_study.py --relabel        # re-label the committed study files (seconds)
 """
 
 from __future__ import annotations
@@ -23,6 +30,7 @@ import argparse
 import hashlib
 import itertools
 import json
+import os
 import time
 from pathlib import Path
 
@@ -30,6 +38,7 @@ import numpy as np
 
 import jaxcelt as jc
 from jaxcelt.ensemble import SweepConfig, run_lanes
+from jaxcelt.provenance import write_result
 from jaxcelt.sweeps.regimes import GLOBAL_MOTION, classify, regime_names
 from jaxcelt.versions import versions
 
@@ -64,6 +73,70 @@ def local_class(name: str) -> str:
     return "periodic" if name.startswith("period-") else name
 
 
+CHAOS_THRESHOLD = 0.02  # [1/s], the README's rule (`classify`'s default)
+CONFIDENCE = 2.0  # half-width of the exponent's interval in standard errors (`classify`'s default)
+RULE = "README: period-k if the samples repeat, else lambda_1 -+ 2 stderr against 0.02 1/s"
+
+
+def relabel(name: str, lyapunov: float | None, stderr: float | None) -> str:
+    """A stored label re-labelled by the README's rule: period-k, invalid and failed stay; a non-periodic
+    lane's label follows from lambda_1 -+ 2 standard errors against 0.02 1/s (the point estimate alone
+    where no standard error is stored)."""
+    if name.startswith("period-") or name in ("invalid", "failed"):
+        return name
+    if lyapunov is None or not np.isfinite(lyapunov):
+        return "aperiodic"
+    se = 0.0 if stderr is None or not np.isfinite(stderr) else float(stderr)
+    lo, hi = lyapunov - CONFIDENCE * se, lyapunov + CONFIDENCE * se
+    if lo > CHAOS_THRESHOLD:
+        return "chaotic"
+    if hi < -CHAOS_THRESHOLD:
+        return "converging"
+    if lo >= -CHAOS_THRESHOLD and hi <= CHAOS_THRESHOLD:
+        return "quasi-periodic"
+    return "uncertain"
+
+
+def score_table(rows: list[dict]) -> list[dict]:
+    """One entry per (reading, eps, start): the labels and the score against the paper, 8 at most (one point
+    per matching local label, periodic of any k counting as periodic, one per matching global label).
+    ``score_strict`` counts a lane that left the model's validity as a miss; ``score_allowed`` labels it as
+    if it were valid."""
+    combos: dict[tuple, list[dict]] = {}
+    for r in rows:
+        combos.setdefault((r["v_pi_sign"], r["derivative_exact"], r["eps"], r["ic"]), []).append(r)
+    table = []
+    for (s, de, e, ic), sub in combos.items():
+        entry = dict(v_pi_sign=s, derivative_exact=de, eps=e, ic=ic, labels={}, score_strict=0, score_allowed=0)
+        for r in sub:
+            want_local, want_global = PAPER[float(r["omega_pi"])]
+            ok_global = r["global_motion"] == want_global
+            for mode in ("strict", "allowed"):
+                entry[f"score_{mode}"] += int(local_class(r[mode]) == want_local) + int(ok_global)
+            entry["labels"][str(r["omega_pi"])] = (
+                f"{r['allowed']}{'' if r['strict'] != 'invalid' else ' (invalid)'}, {r['global_motion']}, λ={r['lyapunov']:.3g}"
+            )
+        table.append(entry)
+    table.sort(key=lambda x: (-x["score_strict"], -x["score_allowed"]))
+    return table
+
+
+def relabel_file(path: Path) -> dict:
+    """Re-label a study file's stored rows by the README's rule and rewrite its score table (no integration)."""
+    d = json.loads(path.read_text())
+    for r in d["rows"]:
+        se = r.get("lyapunov_stderr")
+        r["strict"] = relabel(r["strict"], r["lyapunov"], se)
+        r["allowed"] = relabel(r["allowed"], r["lyapunov"], se)
+    d["table"] = score_table(d["rows"])
+    d["chaos_threshold"] = CHAOS_THRESHOLD
+    d["labelling_rule"] = RULE + (
+        "" if all("lyapunov_stderr" in r for r in d["rows"]) else " (no standard error stored: the point estimate decides)"
+    )
+    path.write_text(json.dumps(d, indent=1, default=str))
+    return d
+
+
 def run(args) -> dict:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -93,6 +166,7 @@ def run(args) -> dict:
     results: dict[str, list] = {}
     chunk = args.chunk
     t_start = time.perf_counter()
+    load_at_start = list(os.getloadavg())
     for c0 in range(0, len(lanes), chunk):
         part = lanes[c0 : c0 + chunk]
         key = hashlib.sha1(repr(part).encode()).hexdigest()[:12]
@@ -120,6 +194,7 @@ def run(args) -> dict:
                     "valid",
                     "r_O",
                     "lyapunov",
+                    "lyapunov_stderr",
                     "first_invalid_kind",
                     "max_tilt",
                     "min_N",
@@ -132,14 +207,11 @@ def run(args) -> dict:
         for k, v in r.items():
             results.setdefault(k, []).append(v)
     R = {k: np.concatenate(v) for k, v in results.items()}
-    # A finite-time exponent of a quasi-periodic orbit decays like 1/t: call a lane chaotic only
-    # when lambda exceeds 2 / (Lyapunov horizon) (and the classifier's 0.02 1/s floor).
-    t_lyap = args.lyapunov * 2 * np.pi / np.array([x[4] for x in lanes])
-    thr = float(np.max(np.maximum(0.02, 2.0 / np.maximum(t_lyap, 1e-9))))
-    lab_strict = classify(R["samples"], R["status"], R["valid"], R["r_O"], R["lyapunov"], chaos_threshold=thr)
-    lab_free = classify(
-        R["samples"], R["status"], np.ones_like(R["valid"]), R["r_O"], R["lyapunov"], chaos_threshold=thr
-    )
+    # the README's rule: lambda_1 -+ 2 standard errors against 0.02 1/s (classify's defaults)
+    thr = CHAOS_THRESHOLD
+    se = R["lyapunov_stderr"]
+    lab_strict = classify(R["samples"], R["status"], R["valid"], R["r_O"], R["lyapunov"], lyapunov_stderr=se)
+    lab_free = classify(R["samples"], R["status"], np.ones_like(R["valid"]), R["r_O"], R["lyapunov"], lyapunov_stderr=se)
     names_strict = regime_names(lab_strict["regime"], lab_strict["period"])
     names_free = regime_names(lab_free["regime"], lab_free["period"])
     rows = []
@@ -155,6 +227,7 @@ def run(args) -> dict:
                 allowed=str(names_free[i]),
                 global_motion=GLOBAL_MOTION[int(lab_free["global_motion"][i])],
                 lyapunov=float(R["lyapunov"][i]),
+                lyapunov_stderr=float(R["lyapunov_stderr"][i]),
                 drift_m=float(R["drift"][i]),
                 max_tilt_deg=float(np.degrees(R["max_tilt"][i])),
                 first_invalid_t=float(R["first_invalid_t"][i]) if "first_invalid_t" in R else None,
@@ -163,27 +236,13 @@ def run(args) -> dict:
                 steps=int(R["num_steps"][i]),
             )
         )
-    # score each combination against the paper
-    table = []
-    for s, de, e, ic in combos:
-        sub = [r for r in rows if (r["v_pi_sign"], r["derivative_exact"], r["eps"], r["ic"]) == (s, de, e, ic)]
-        entry = dict(v_pi_sign=s, derivative_exact=de, eps=e, ic=ic, labels={}, score_strict=0, score_allowed=0)
-        for r in sub:
-            want_local, want_global = PAPER[r["omega_pi"]]
-            ok_global = r["global_motion"] == want_global
-            for mode in ("strict", "allowed"):
-                ok_local = local_class(r[mode]) == want_local
-                entry[f"score_{mode}"] += int(ok_local) + int(ok_global)
-            entry["labels"][str(r["omega_pi"])] = (
-                f"{r['allowed']}{'' if r['strict'] != 'invalid' else ' (invalid)'}, {r['global_motion']}, λ={r['lyapunov']:.3g}"
-            )
-        table.append(entry)
-    table.sort(key=lambda x: (-x["score_allowed"], -x["score_strict"]))
+    table = score_table(rows)
     summary = dict(
         config=dict(vars(args)),
         versions=versions(),
         wall_s=time.perf_counter() - t_start,
         chaos_threshold=thr,
+        labelling_rule=RULE,
         paper=PAPER,
         rows=rows,
         table=table,
@@ -191,11 +250,11 @@ def run(args) -> dict:
     tag = args.tag or ("quick" if args.quick else f"T{args.transient}_rtol{args.rtol:g}")
     docs = Path(args.docs)
     docs.mkdir(parents=True, exist_ok=True)
-    (docs / f"study_{tag}.json").write_text(json.dumps(summary, indent=1, default=str))
-    print(f"max score 8 (4 local + 4 global). Best combinations ({tag}):")
+    write_result(docs / f"study_{tag}.json", summary, load_at_start=load_at_start, default=str)
+    print(f"max score 8 (4 local + 4 global). Best combinations ({tag}), strict then allowed:")
     for t in table[:10]:
         print(
-            t["score_allowed"], t["score_strict"], t["v_pi_sign"], t["derivative_exact"], t["eps"], t["ic"], t["labels"]
+            t["score_strict"], t["score_allowed"], t["v_pi_sign"], t["derivative_exact"], t["eps"], t["ic"], t["labels"]
         )
     return summary
 
@@ -203,6 +262,7 @@ def run(args) -> dict:
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--relabel", action="store_true", help="re-label the study files in --docs by the README's rule")
     ap.add_argument("--transient", type=int, default=300)
     ap.add_argument("--sample", type=int, default=64)
     ap.add_argument("--lyapunov", type=int, default=60)
@@ -217,6 +277,11 @@ def main(argv=None):
     ap.add_argument("--out", default="runs/paper_study")
     ap.add_argument("--docs", default="docs/paper-reproduction")
     args = ap.parse_args(argv)
+    if args.relabel:
+        for f in sorted(Path(args.docs).glob("study_*.json")):
+            t = relabel_file(f)["table"][0]
+            print(f"{f.name}: best {t['score_strict']} strict / {t['score_allowed']} allowed ({t['ic']}, eps {t['eps']:g})")
+        return
     if args.quick:
         args.transient, args.sample, args.lyapunov, args.eps, args.chunk = 20, 16, 8, ["1e-4"], 16
     run(args)

@@ -441,14 +441,41 @@ def test_heading_study_has_sixteen_headings_and_a_roll():
     assert starts - {s for s in starts if s.startswith("rest psi0=")} == {"roll 2deg"}
 
 
-def test_best_score_is_six_of_eight():
-    scores = [
-        row["score_allowed"]
-        for f in (DOCS / "paper-reproduction").glob("study_*.json")
-        for row in json.loads(f.read_text())["table"]
-        if "score_allowed" in row
-    ]
-    assert max(scores) == 6
+def _paper_study():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("paper_study", ROOT / "scripts" / "paper_study.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_best_paper_score_by_the_readme_rule():
+    """The paper score quoted in the README and docs/paper-reproduction.md: the README's labelling rule
+    (period-k, else lambda_1 -+ 2 stderr against 0.02 1/s) re-applied to every stored row, strict score first.
+    Rows with a standard error decide the headline; point-estimate-only files can score one more (the 17 rad/s
+    lane the standard error makes uncertain), as the document says."""
+    ps = _paper_study()
+    best = {True: [0, 0], False: [0, 0]}  # has stderr -> [strict, allowed]
+    for f in sorted((DOCS / "paper-reproduction").glob("study_*.json")):
+        d = json.loads(f.read_text())
+        assert d["labelling_rule"].startswith("README"), f.name
+        rows = [dict(r) for r in d["rows"]]
+        for r in rows:  # the stored labels are the rule's
+            se = r.get("lyapunov_stderr")
+            assert ps.relabel(r["strict"], r["lyapunov"], se) == r["strict"], (f.name, r)
+            assert ps.relabel(r["allowed"], r["lyapunov"], se) == r["allowed"], (f.name, r)
+        has_se = all("lyapunov_stderr" in r for r in rows)
+        for t in ps.score_table(rows):
+            best[has_se][0] = max(best[has_se][0], t["score_strict"])
+            best[has_se][1] = max(best[has_se][1], t["score_allowed"])
+    assert best[True] == [4, 5]
+    assert best[False][0] <= 5
+    for doc in ("README.md", "docs/paper-reproduction.md"):
+        flat = " ".join(_text(doc).split())
+        assert f"{best[True][0]} of 8" in flat and f"{best[True][1]} of 8" in flat, doc
+    flat = " ".join(_text("docs/paper-reproduction.md").split())
+    assert f"{best[True][0]} of 8 labels with the model's validity enforced" in flat
 
 
 def test_repository_url_is_declared_once_and_used_by_the_notebooks():
