@@ -358,6 +358,12 @@ QUOTES = [
             _json("docs/orbits/branches.json")["brute_force"]["seconds_incl_compile"]
         ),
     ),
+    (
+        "docs/orbits/README.md",
+        lambda: "first call including compilation {:.1f} s, one Newton solve with the multipliers {:.2f} s".format(
+            _first_branch()["seconds"]["newton_first_call_incl_compile"], _first_branch()["seconds"]["newton_solve"]
+        ),
+    ),
     ("docs/orbits/README.md", lambda: f"ω_fold = {_json('docs/orbits/celt_fold_grad.json')['omega_fold']:.6f} rad/s"),
     (
         "docs/orbits/README.md",
