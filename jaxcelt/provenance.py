@@ -103,7 +103,7 @@ def provenance(*, load_at_start: list[float] | None = None) -> dict[str, Any]:
     """
     rec: dict[str, Any] = {
         **source_commit(),
-        "written_utc": _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat(),
+        "written_utc": _dt.datetime.now(_dt.UTC).replace(microsecond=0).isoformat(),
         "command": shlex.join([Path(sys.argv[0]).name, *sys.argv[1:]]) if sys.argv and sys.argv[0] else None,
         "machine": machine(),
         "versions": versions(),
@@ -115,12 +115,25 @@ def provenance(*, load_at_start: list[float] | None = None) -> dict[str, Any]:
 
 
 def write_result(
-    path: str | os.PathLike, data: dict[str, Any], *, load_at_start: list[float] | None = None, indent: int = 1
+    path: str | os.PathLike,
+    data: dict[str, Any],
+    *,
+    load_at_start: list[float] | None = None,
+    indent: int | None = 1,
+    default=None,
 ) -> Path:
     """Write ``data`` as a JSON result file at ``path`` with ``data["provenance"] = provenance()``.
 
     The file is written to a temporary name and renamed, so an interrupted write never leaves a damaged result.
     Returns the path written.
+
+    Args:
+        path: the JSON file to write (its folder is created).
+        data: the result, a dict; a ``"provenance"`` key in it is replaced.
+        load_at_start: see ``provenance``.
+        indent: JSON indentation (``None``: one line).
+        default: how to write objects JSON does not know (as ``json.dumps``); numpy and JAX scalars and arrays
+            and paths are written as numbers, lists and strings without it.
     """
     if not isinstance(data, dict):
         raise ValueError(f"data: a result must be a dict (a JSON object), got {type(data).__name__}")
@@ -128,7 +141,15 @@ def write_result(
     path.parent.mkdir(parents=True, exist_ok=True)
     out = {**data, "provenance": provenance(load_at_start=load_at_start)}
     tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(out, indent=indent, default=_default) + "\n", encoding="utf-8")
+    def fallback(x):
+        try:
+            return _default(x)
+        except TypeError:
+            if default is None:
+                raise
+            return default(x)
+
+    tmp.write_text(json.dumps(out, indent=indent, default=fallback) + "\n", encoding="utf-8")
     os.replace(tmp, path)
     return path
 

@@ -132,6 +132,7 @@ def run(args) -> int:
     import jaxcelt as jc
     from jaxcelt.commands._warnings import one_line_warnings
     from jaxcelt.integrate.solvers import make_solver
+    from jaxcelt.provenance import write_result
     from jaxcelt.sweeps.api import sweep
     from jaxcelt.sweeps.dataset import open_sweep
     from jaxcelt.sweeps.regimes import regime_runs
@@ -197,7 +198,7 @@ def run(args) -> int:
         "lanes_invalid": int(np.sum(ds["valid"].values == 0)),
         "regimes": regime_runs(ds),
     }
-    (args.out / "summary.json").write_text(json.dumps(summary, indent=1))
+    write_result(args.out / "summary.json", summary)
     if not args.no_figures:
         _figures(args, ds, params, omega0, solver)
     files = sorted(f.name for f in args.out.iterdir() if f.is_file() and f.name != "manifest.json")

@@ -8,7 +8,6 @@ bar with the loss, prints the fitted values with 95% intervals, writes a JSON re
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 from jaxcelt.commands.args import UsageError, override, overrides, positive_float, positive_int
@@ -152,15 +151,13 @@ def run(args) -> int:
         for n, (lo, hi) in summary["spread"].items():
             print(f"  {n:>8s} in [{lo:.6g}, {hi:.6g}]")
     args.out.mkdir(parents=True, exist_ok=True)
-    from jaxcelt.versions import versions
+    from jaxcelt.provenance import write_result
 
-    (args.out / "fit.json").write_text(
-        json.dumps(
-            res.to_dict()
-            | {"data": [str(p) for p in args.data], "versions": versions()}
-            | ({"multistart": summary} if summary is not None else {}),
-            indent=1,
-        )
+    write_result(
+        args.out / "fit.json",
+        res.to_dict()
+        | {"data": [str(p) for p in args.data]}
+        | ({"multistart": summary} if summary is not None else {}),
     )
     print(f"wrote {args.out / 'fit.json'}")
     if not args.no_plot:

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import json
-
 from jaxcelt.commands.args import UsageError, positive_float
 
 
@@ -60,6 +58,7 @@ def run(args) -> int:
             "state": need,
         }
     if args.json:
-        with open(args.json, "w") as f:
-            json.dump(out, f, indent=1)
+        from jaxcelt.provenance import write_result
+
+        write_result(args.json, out)
     return 0

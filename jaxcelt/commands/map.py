@@ -98,6 +98,7 @@ def run(args) -> int:
     import jaxcelt as jc
     from jaxcelt.commands._warnings import one_line_warnings
     from jaxcelt.integrate.solvers import make_solver
+    from jaxcelt.provenance import write_result
     from jaxcelt.versions import versions_string
 
     # bad input raises ValueError naming the parameter (jaxcelt.cli: one error line, exit 2), before any work
@@ -136,7 +137,7 @@ def run(args) -> int:
         "load_average_at_start": None if load is None else [round(v, 2) for v in load],
         **summarize(ds),
     }
-    (args.out / "summary.json").write_text(json.dumps(summary, indent=1))
+    write_result(args.out / "summary.json", summary, load_at_start=load)
     print(json.dumps(summary, indent=1), flush=True)
     if not args.no_figures:
         import matplotlib

@@ -13,7 +13,6 @@ stone at 15.6 rad/s)::
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from pathlib import Path
 
@@ -78,6 +77,7 @@ def run(args) -> int:
     from jaxcelt.orbits.branch import branch_to_dict
     from jaxcelt.orbits.celt import ORBIT_STATUS
     from jaxcelt.physics.model import STATE_NAMES
+    from jaxcelt.provenance import write_result
     from jaxcelt.versions import versions
 
     params = jc.CeltParams.paper(**(dict(omega_pi=args.omega_pi, q_pi=args.q_pi) | overrides(args.set)))
@@ -155,7 +155,7 @@ def run(args) -> int:
                 + ", ".join(f"{a:.4f}" for a in np.abs(b.multipliers[:3]))
             )
     path = args.out / "orbits.json"
-    path.write_text(json.dumps(result, indent=1))
+    write_result(path, result)
     print(f"wrote {path}")
     if branch is not None and not args.no_plot:
         import matplotlib

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from pathlib import Path
 
@@ -38,6 +37,7 @@ def run(args) -> int:
 
     import jaxcelt as jc
     from jaxcelt.integrate.io import save_trajectory
+    from jaxcelt.provenance import write_result
 
     # a bad value raises ValueError naming the parameter: jaxcelt.cli prints it as one error line, exit 2
     params = jc.CeltParams.paper(**(dict(omega_pi=args.omega_pi, q_pi=args.q_pi) | overrides(args.set)))
@@ -69,7 +69,7 @@ def run(args) -> int:
     path = save_trajectory(
         args.out / f"{stem}.npz", sol.ts, sol.ys, params, meta=meta, extra={"N": diag.N, "r_O": diag.r_O}
     )
-    (args.out / f"{stem}.json").write_text(json.dumps(meta, indent=2))
+    write_result(args.out / f"{stem}.json", meta, indent=2)
     print(f"wrote {path}")
     if not args.no_plot:
         import matplotlib

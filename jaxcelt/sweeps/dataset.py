@@ -88,6 +88,7 @@ def _jsonable(x: Any) -> Any:
 
 
 def _attrs(params: CeltParams, name: str, config: Any, n_starts: int) -> dict[str, Any]:
+    from jaxcelt.provenance import machine, source_commit
     from jaxcelt.versions import versions
 
     pd = params.as_dict()
@@ -108,6 +109,8 @@ def _attrs(params: CeltParams, name: str, config: Any, n_starts: int) -> dict[st
         "lyapunov_periods": cfg["lyapunov_periods"],
         "config_json": json.dumps(cfg, sort_keys=True),
         "versions_json": json.dumps(versions(), sort_keys=True),
+        # the code and machine (not the time or load: a resumed sweep equals an uninterrupted one)
+        "provenance_json": json.dumps({**source_commit(), "machine": machine()}, sort_keys=True),
         "regime_codes": json.dumps(REGIMES),
         "global_motion_codes": json.dumps(GLOBAL_MOTION),
         "state_names": ",".join(STATE_NAMES),
