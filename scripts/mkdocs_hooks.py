@@ -1,5 +1,5 @@
-"""MkDocs hooks (``mkdocs.yml: hooks``): the site's home page is the repository's README.md and the
-notebooks are pages, without copying either into docs/; links that leave docs/ (to source files,
+"""MkDocs hooks (``mkdocs.yml: hooks``): the site's home page is the repository's README.md, the changelog
+and the benchmark scripts' README and the notebooks are pages, without copying any of them into docs/; links that leave docs/ (to source files,
 benchmarks, tests) point to the repository, whose URL is read from pyproject.toml."""
 
 from __future__ import annotations
@@ -14,12 +14,16 @@ from mkdocs.structure.files import File
 ROOT = Path(__file__).resolve().parents[1]
 REPO = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["urls"]["Repository"]
 BLOB = f"{REPO}/blob/main/"
+# site pages whose source lies outside docs/: site page -> source file, relative to the repository root
+# (links in each are relative to its source file, as on the repository's web view)
+OUTSIDE_PAGES = {"index.md": "README.md", "changelog.md": "CHANGELOG.md", "benchmarks.md": "benchmarks/README.md"}
 _LINK = re.compile(r"(!?\[[^\]]*\]\()([^)\s#]+)(#[^)\s]*)?(\))")
 
 
 @event_priority(100)  # before mkdocs-jupyter's on_files, so the notebooks become notebook pages
 def on_files(files, config):
-    files.append(File.generated(config, "index.md", abs_src_path=str(ROOT / "README.md")))
+    for uri, src in OUTSIDE_PAGES.items():
+        files.append(File.generated(config, uri, abs_src_path=str(ROOT / src)))
     for nb in sorted((ROOT / "notebooks").glob("*.ipynb")):
         files.append(File(f"notebooks/{nb.name}", str(ROOT), config["site_dir"], config["use_directory_urls"]))
     return files
@@ -28,8 +32,8 @@ def on_files(files, config):
 def on_page_markdown(markdown, page, config, files):
     """Rewrite relative links as if the page sat where its source file is in the repository."""
     src = page.file.src_uri
-    if src == "index.md":
-        here, site_here = ROOT, Path(".")
+    if src in OUTSIDE_PAGES:
+        here, site_here = (ROOT / OUTSIDE_PAGES[src]).parent, Path(".")
     else:
         here, site_here = ROOT / "docs" / Path(src).parent, Path(src).parent
 

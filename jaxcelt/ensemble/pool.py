@@ -58,7 +58,7 @@ DEFAULT_WIDTH = 96
 """pool slots per device. Each pool iteration pays a fixed cost (hundreds of XLA kernel
 launches on CPU) besides its per-slot work, so wider pools finish in fewer iterations; 96 was
 the fastest width for 400 lanes x 300 periods on 2 cores with the pilot pause
-(``benchmarks/bench_schedule.py``; docs/bifurcation/README.md)."""
+(``benchmarks/bench_schedule.py``; docs/internals/sweep-engine.md)."""
 MIN_DRAIN_WIDTH = 4
 """the drain's last width (by default `SEQUENTIAL_WIDTH`, so that it steps in the inner loop)"""
 DRAIN_FACTOR = 4

@@ -260,7 +260,7 @@ def _fill_implicit_tols(solver, rtol, atol):
             # Jacobian changes by ~1/sqrt(eps) within a step during stick-slip, so the chord
             # iteration diverges and steps are rejected en masse (Kvaerno5, one period from rest,
             # omega_pi = 17: 2005 accepted + 2417 rejected steps, vs 293 + 103 with full Newton;
-            # docs/performance.md section 3). Use full Newton unless the user chose a root finder.
+            # docs/internals/studies.md section 3). Use full Newton unless the user chose a root finder.
             rf = optx.Newton(rtol=rtol, atol=atol, norm=optx.rms_norm)
         for attr, val in (("rtol", rtol), ("atol", atol), ("norm", optx.rms_norm)):
             if getattr(rf, attr, None) is use_stepsize_tol:

@@ -164,7 +164,7 @@ class GeneralisedPade(AbstractContactLaw):
 
     def wide_batch(self) -> GeneralisedPade:
         """With ``vector_log``: faster in wide batches on a CPU, but its inlined polynomial makes
-        XLA's compilation of a many-stage program about a second longer (docs/bifurcation/README.md)."""
+        XLA's compilation of a many-stage program about a second longer (docs/internals/sweep-engine.md)."""
         return dataclasses.replace(self, vector_log=True)
 
     def friction(self, kin, d_c, d_s, p):

@@ -1,0 +1,294 @@
+"""The results index: every measured number the docs quote, the result file it comes from and the command that made it.
+
+    python scripts/results_index.py            # write docs/results.md (the index page) and print a summary
+    python scripts/results_index.py --check    # exit 1 if docs/results.md is out of date or a quoted number is unverified
+
+A *quoted number* is a measured quantity in the prose of a site page, the README or a notebook's text: a time
+(``12.3 s``, ``450 ms``, ``2 min``), a ratio (``2.12×``), a percentage (``17.7 %``) or a step count in millions
+(``35.2 M``). Each one must be either
+
+* **verified**: it lies inside a text that ``tests/test_docs_numbers.py`` recomputes from a committed result file
+  (the ``QUOTES`` registry in ``tests/docs_quotes``: document, text computed from the file); the index records which files each such text reads,
+  the command that wrote each file (its ``provenance`` block, else the script that writes that file) and whether
+  the file is older than the code it describes; or
+* **a setting**: an input rather than a result (``t = 300 s``, ``a threshold of 0.02 s⁻¹``, ``1 s gyro records``),
+  recognised by the words just before it (``INPUT_CONTEXT``) or lying inside a phrase of the registry's
+  ``SETTINGS`` list (document, phrase: each phrase must occur in its document).
+
+Everything else is *unverified*, and ``--check`` (run by the test suite) fails on it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import re
+import subprocess
+import sys
+from collections import defaultdict
+from dataclasses import dataclass, field
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+INDEX = DOCS / "results.md"
+
+# A measured quantity: a number with a unit of time, a ratio, a percentage or millions of steps.
+NUMBER = re.compile(
+    r"(?<![\w.])(\d+(?:[.,]\d+)*)(?:\s?[–-]\s?\d+(?:\.\d+)?)?"  # 12.3, 1,124, 14–17
+    r"(?:\s?(?:s|ms|min|h)\b(?!-)|\s?×(?!\s?\d)|\s?%|\s?M\b(?= (?:steps|lane-steps|lanes? ?steps)))"
+)
+# words before a number that make it a setting, not a result (checked on the 40 characters before it)
+INPUT_CONTEXT = re.compile(
+    r"(?:\bt\s?[=∈]|\bt_end\b|\bT\s?=|\bdt\s?=?|horizon|transient|--[\w-]+|timeout|time limit|at most|"
+    r"threshold|tolerance|noise|rtol|atol|ε|eps|±|[<>≤≥])\s*\S*\s*\S*\s*$",
+    re.IGNORECASE,
+)
+
+
+@dataclass
+class Quote:
+    doc: str
+    text: str
+    files: list[str] = field(default_factory=list)
+    ok: bool = True
+
+
+def site_documents() -> list[Path]:
+    """The pages a reader sees: the site's markdown (docs/), README, CHANGELOG, benchmarks/README, notebooks."""
+    pages = sorted(p for p in DOCS.rglob("*.md") if p != INDEX and "contact/scene_table" not in p.as_posix())
+    return [ROOT / "README.md", *pages, ROOT / "benchmarks" / "README.md", *sorted((ROOT / "notebooks").glob("*.ipynb"))]
+
+
+def prose(path: Path) -> str:
+    """The text a reader reads: markdown without code blocks; a notebook's markdown cells."""
+    if path.suffix == ".ipynb":
+        nb = json.loads(path.read_text(encoding="utf-8"))
+        text = "\n\n".join("".join(c["source"]) for c in nb["cells"] if c["cell_type"] == "markdown")
+    else:
+        text = path.read_text(encoding="utf-8")
+    text = re.sub(r"```.*?```", " ", text, flags=re.S)  # code blocks: commands and their settings
+    text = re.sub(r"`[^`\n]*`", lambda m: " " * len(m.group(0)), text)  # inline code: flags, names
+    text = re.sub(r"\]\([^)]*\)", "]()", text)  # link targets
+    return " ".join(text.split())
+
+
+def load_quotes() -> tuple[list[Quote], list[Quote]]:
+    """Evaluate the registry's QUOTES (``tests/docs_quotes``), recording the files each quoted text reads."""
+    sys.path.insert(0, str(ROOT / "tests"))
+    try:
+        registry = importlib.import_module("docs_quotes")
+    finally:
+        sys.path.remove(str(ROOT / "tests"))
+    reads: list[str] = []
+    original = Path.read_text
+
+    def recording(self, *a, **k):
+        p = Path(self).resolve()
+        if p.suffix in (".json", ".npz") or (p.suffix == ".md" and "docs" in p.parts and p.parent != DOCS):
+            try:
+                reads.append(p.relative_to(ROOT).as_posix())
+            except ValueError:
+                pass
+        return original(self, *a, **k)
+
+    quotes = []
+    settings = [Quote(doc, " ".join(phrase.split()), [], True) for doc, phrase in registry.SETTINGS]
+    Path.read_text = recording
+    try:
+        for doc, fn in registry.QUOTES:
+            reads.clear()
+            try:
+                text = fn()
+            except Exception as e:  # a quote that cannot be computed is reported, not hidden
+                quotes.append(Quote(doc, f"<error: {type(e).__name__}: {e}>", [], False))
+                continue
+            files = sorted({r for r in reads if not r.endswith(".md") or r != doc})
+            quotes.append(Quote(doc, " ".join(text.split()), files, True))
+    finally:
+        Path.read_text = original
+    return quotes, settings
+
+
+def _spans(text: str, phrases: list[Quote]) -> list[tuple[int, int]]:
+    return [(m.start(), m.end()) for q in phrases for m in re.finditer(re.escape(_prose_of(q.text)), text)]
+
+
+def scan(quotes: list[Quote], settings: list[Quote]) -> dict[str, dict]:
+    """Per document: quoted numbers, verified / input / unverified (with their context)."""
+    by_doc = defaultdict(list)
+    for q in quotes:
+        by_doc[q.doc].append(q)
+    set_by_doc = defaultdict(list)
+    for q in settings:
+        set_by_doc[q.doc].append(q)
+    out = {}
+    for path in site_documents():
+        rel = path.relative_to(ROOT).as_posix()
+        text = prose(path)
+        raw = " ".join(path.read_text(encoding="utf-8").split()) if path.suffix != ".ipynb" else text
+        n_quotes_found = sum(q.ok and q.text in raw for q in by_doc.get(rel, []))
+        covered = _spans(text, by_doc.get(rel, []))  # spans of verified quote texts, in the prose
+        declared = _spans(text, set_by_doc.get(rel, []))  # spans of declared settings
+        rec = {"verified": [], "input": [], "unverified": [], "quotes": len(by_doc.get(rel, [])), "quotes_found": n_quotes_found}
+        for m in NUMBER.finditer(text):
+            ctx = text[max(0, m.start() - 60) : m.end() + 30]
+            if any(a <= m.start() and m.end() <= b for a, b in covered):
+                rec["verified"].append(m.group(0))
+            elif any(a <= m.start() and m.end() <= b for a, b in declared) or INPUT_CONTEXT.search(
+                text[max(0, m.start() - 40) : m.start()]
+            ):
+                rec["input"].append(m.group(0))
+            else:
+                rec["unverified"].append(ctx)
+        out[rel] = rec
+    return out
+
+
+def _prose_of(s: str) -> str:
+    s = re.sub(r"`[^`\n]*`", lambda m: " " * len(m.group(0)), s)
+    return " ".join(s.split())
+
+
+def _git(*args: str) -> str:
+    return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+
+
+def file_record(rel: str, writers: dict[str, str]) -> dict:
+    """What made a result file: its provenance block, else the script that writes it; and its age."""
+    path = ROOT / rel
+    rec: dict = {"file": rel}
+    prov = None
+    if path.suffix == ".json":
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+            prov = data.get("provenance") if isinstance(data, dict) else None
+        except (OSError, ValueError):
+            prov = None
+    committed = _git("log", "-1", "--format=%h %cs", "--", rel)
+    rec["committed"] = committed or "not committed"
+    if prov:
+        rec["command"] = prov.get("command")
+        rec["commit"] = (prov.get("commit") or "")[:10] + (" (dirty tree)" if prov.get("dirty") else "")
+        m = prov.get("machine", {})
+        rec["machine"] = f"{m.get('accelerator') or m.get('cpu')}, {m.get('cpu_cores')} cores"
+        load = prov.get("load_average_at_start") or prov.get("load_average")
+        rec["load"] = load[0] if load else None
+        base = prov.get("commit")
+    else:
+        rec["command"] = writers.get(Path(rel).name) or writers.get(rel)
+        rec["commit"] = None
+        rec["machine"] = None
+        rec["load"] = None
+        # without a recorded commit: the commit that added the file is the latest code it can describe
+        base = _git("log", "-1", "--format=%H", "--", rel) or None
+    if base:
+        changed = _git("rev-list", "--count", f"{base}..HEAD", "--", "jaxcelt")
+        rec["code_commits_since"] = int(changed) if changed.isdigit() else None
+    else:
+        rec["code_commits_since"] = None
+    return rec
+
+
+def writers() -> dict[str, str]:
+    """Result file name -> the script that writes it (for files that record no command): a scan of the scripts."""
+    out = {}
+    for script in sorted([*(ROOT / "scripts").glob("*.py"), *(ROOT / "benchmarks").glob("*.py")]):
+        src = script.read_text(encoding="utf-8")
+        for name in set(re.findall(r"[\"'/]([\w.\-{}]+\.json)[\"']", src)):
+            if "{" in name:
+                continue
+            out.setdefault(name, f"python {script.relative_to(ROOT).as_posix()}")
+    out.setdefault("summary.json", "jaxcelt bifurcation / jaxcelt map")
+    return out
+
+
+def render(quotes: list[Quote], scanned: dict[str, dict]) -> str:
+    w = writers()
+    files = sorted({f for q in quotes for f in q.files})
+    recs = {f: file_record(f, w) for f in files}
+    n_num = sum(len(r["verified"]) + len(r["input"]) + len(r["unverified"]) for r in scanned.values())
+    n_ver = sum(len(r["verified"]) for r in scanned.values())
+    n_in = sum(len(r["input"]) for r in scanned.values())
+    n_un = sum(len(r["unverified"]) for r in scanned.values())
+    lines = [
+        "# Results index",
+        "",
+        "Generated by `python scripts/results_index.py` (do not edit by hand). Every measured number the site, the",
+        "README and the notebooks quote (a time, a ratio, a percentage, a step count) is either recomputed from the",
+        "result file below by `tests/test_docs_numbers.py`, or is a setting rather than a result. A file that records",
+        "no commit predates the provenance block; its *code commits since* counts the commits to `jaxcelt/` after",
+        "the commit that added the file — a result older than the code it describes.",
+        "",
+        f"**{len(quotes)} quoted texts** checked against **{len(files)} result files**; over all pages, "
+        f"**{n_num} quoted numbers**: {n_ver} verified, {n_in} settings, {n_un} unverified.",
+        "",
+        "## Result files",
+        "",
+        "| file | made by | commit | machine | load | code commits since |",
+        "|---|---|---|---|---|---|",
+    ]
+    for f in files:
+        r = recs[f]
+        lines.append(
+            f"| `{f}` | `{r['command'] or '?'}` | {r['commit'] or 'not recorded'} | {r['machine'] or 'not recorded'} "
+            f"| {'' if r['load'] is None else r['load']} | {'' if r['code_commits_since'] is None else r['code_commits_since']} |"
+        )
+    lines += ["", "## Quoted texts, by page", ""]
+    by_doc = defaultdict(list)
+    for q in quotes:
+        by_doc[q.doc].append(q)
+    for doc in sorted(by_doc):
+        lines += [f"### `{doc}`", "", "| quoted | from |", "|---|---|"]
+        for q in by_doc[doc]:
+            t = q.text.replace("|", "\\|")
+            if len(t) > 140:
+                t = t[:137] + "…"
+            lines.append(f"| {t} | {', '.join(f'`{f}`' for f in q.files) or '(the test collection)'} |")
+        lines.append("")
+    lines += [
+        "## Quoted numbers per page",
+        "",
+        "| page | quoted numbers | verified | settings | unverified |",
+        "|---|---|---|---|---|",
+    ]
+    for doc, r in scanned.items():
+        n = len(r["verified"]) + len(r["input"]) + len(r["unverified"])
+        if n:
+            lines.append(f"| `{doc}` | {n} | {len(r['verified'])} | {len(r['input'])} | {len(r['unverified'])} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--check", action="store_true", help="fail if the index is stale or a number is unverified")
+    ap.add_argument("--show", action="store_true", help="print every unverified number with its context")
+    a = ap.parse_args(argv)
+    quotes, settings = load_quotes()
+    scanned = scan(quotes, settings)
+    page = render(quotes, scanned)
+    unverified = {d: r["unverified"] for d, r in scanned.items() if r["unverified"]}
+    if a.show:
+        for d, ctxs in unverified.items():
+            for c in ctxs:
+                print(f"{d}: …{c}…")
+    n_un = sum(map(len, unverified.values()))
+    print(
+        f"{len(quotes)} quoted texts; "
+        + ", ".join(f"{k} {sum(len(r[k]) for r in scanned.values())}" for k in ("verified", "input", "unverified"))
+    )
+    if a.check:
+        stale = not INDEX.exists() or INDEX.read_text(encoding="utf-8") != page
+        if stale:
+            print("docs/results.md is out of date: run python scripts/results_index.py", file=sys.stderr)
+        if n_un:
+            print(f"{n_un} quoted numbers are not verified (--show lists them)", file=sys.stderr)
+        return 1 if (stale or n_un) else 0
+    INDEX.write_text(page, encoding="utf-8")
+    print(f"wrote {INDEX.relative_to(ROOT)}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,103 @@
+"""Readers of the committed result files for the quoted-number checks (``docs_quotes``).
+
+Each check recomputes a quoted number from its JSON file (or from the test collection) and asserts
+that the document contains it as written. A failure means a result file was regenerated (or a test
+added) without updating the prose, or the prose was edited without a result behind it.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+DOCS = ROOT / "docs"
+
+
+def _text(rel: str) -> str:
+    return (ROOT / rel).read_text(encoding="utf-8")
+
+
+def _json(rel: str):
+    return json.loads((ROOT / rel).read_text(encoding="utf-8"))
+
+
+def _bench():
+    return _json("docs/bifurcation/bench_sweep_400x300.json")
+
+
+def _vector_width():
+    return _json("docs/bifurcation/vector_width.json")["summary"]
+
+
+def _processes():
+    return _json("docs/bifurcation/processes.json")
+
+
+def _runs(key: str) -> str:
+    """A pool timing as the benchmark table gives it: median (each run; + compile)."""
+    r = _bench()[key]
+    each = ", ".join(f"{x:.1f}" for x in r["seconds_each_run"])
+    return f"{r['seconds']:.1f} ({each}; + {r['compile_seconds']:.1f} compile)"
+
+
+def _vs(ratio: float) -> str:
+    """A wall-time ratio jaxcelt / other as the docs word it."""
+    return f"{ratio:.2f}× slower" if ratio >= 1 else f"{1 / ratio:.2f}× faster"
+
+
+def _first_branch() -> dict:
+    return next(iter(_json("docs/orbits/branches.json")["branches"].values()))
+
+
+def _bif(kind: str) -> dict:
+    return next(b for b in _first_branch()["branch"]["bifurcations"] if b["kind"] == kind)
+
+
+def _starts() -> set[str]:
+    """Distinct initial conditions over the paper-reproduction study files (same start, one name)."""
+    alias = {"rest psi0=0": "rest psi0=0deg", "rest psi0=pi/2": "rest psi0=90deg"}
+    ics = set()
+    for f in sorted((DOCS / "paper-reproduction").glob("study_*.json")):
+        ics |= {alias.get(r["ic"], r["ic"]) for r in json.loads(f.read_text())["rows"]}
+    return ics
+
+
+def _lambda14() -> tuple[float, float]:
+    lam = [
+        r["lyapunov"]
+        for f in (DOCS / "paper-reproduction").glob("study_*.json")
+        for r in json.loads(f.read_text())["rows"]
+        if r["omega_pi"] == 14.0 and r["lyapunov"] is not None
+    ]
+    return min(lam), max(lam)
+
+
+def _long14() -> str:
+    rows = {r["kind"]: r for r in _json("docs/orbits/census_long14/census.json")["results"]["14"]["attractors"]}
+    c, i, q = rows["chaotic"], rows["invalid"], rows["quasi-periodic"]
+    periodic = "none periodic" if "periodic" not in rows else "some periodic"
+    return (
+        f"chaotic {c['fraction']:.3f} (median λ₁ {c['lyapunov']:.3f} s⁻¹), invalid {i['fraction']:.3f}, "
+        f"quasi-periodic {q['fraction']:.3f}, and {periodic}"
+    )
+
+
+def _per_step_512(mode: str) -> float:
+    """512-bit over 256-bit vectors per step: the two programs' lanes may take different step counts."""
+    r = _vector_width()[mode]
+    return (r["256"]["run_s"] / r["256"]["steps"]) / (r["512"]["run_s"] / r["512"]["steps"])
+
+
+def _main_job_time() -> str:
+    """The README's main-job time and, once summary.json carries a provenance block, the machine it ran on."""
+    d = _json("docs/bifurcation/summary.json")
+    text = f"{d['wall_seconds_including_compile']:.1f} s including compilation"
+    prov = d.get("provenance")
+    if prov:
+        m = prov["machine"]
+        text += f" on {m['cpu']}, {m['cpu_cores_usable']} cores"
+    return text
+
+
+# (document, quoted text computed from the result file)
