@@ -1,0 +1,156 @@
+"""Quoted texts of the map, periodic-orbit and paper-reproduction pages (and the regime-label how-to, the model
+page and the notebooks' text), each computed from the result file it comes from.
+
+Each entry is (document, function returning the quoted text); ``SETTINGS`` lists (document, phrase) for numbers
+that are inputs, not results.
+"""
+
+from __future__ import annotations
+
+from .files import _json
+
+MAP = "docs/map/README.md"
+ORBITS = "docs/orbits/README.md"
+PAPER = "docs/paper-reproduction.md"
+LABELS = "docs/how-to/regime-labels.md"
+
+
+def _m(x: float, fmt: str) -> str:
+    """A number as the docs print it: a unicode minus."""
+    return format(x, fmt).replace("-", "−")
+
+
+# ---- docs/map/README.md: the 100 x 60 map (scripts/map_study.py) and its window check (scripts/map_lyapunov_check.py)
+
+
+def _map() -> dict:
+    return _json("docs/map/map_omega_q_100x60.json")
+
+
+def _wc() -> dict:
+    return _json("docs/map/lyapunov_window_check.json")
+
+
+def _wc_lanes(group: str) -> list[int]:
+    return [i for i, lane in enumerate(_wc()["lanes"]) if lane["group"] == group]
+
+
+def _wc_periodic() -> list[int]:
+    """Lanes of the lower left that are period-1 after the long transient."""
+    lt = _wc()["runs"]["long_transient"]["label"]
+    return [i for i in _wc_lanes("low") if lt[i].startswith("period")]
+
+
+def _wc_values(run: str, idx: list[int], key: str = "lyapunov_per_s") -> list[float]:
+    v = _wc()["runs"][run][key]
+    return [v[i] for i in idx if v[i] is not None]
+
+
+def _wc_range(run: str, idx: list[int]) -> str:
+    v = _wc_values(run, idx)
+    return f"{_m(min(v), '.2f')} to {_m(max(v), '.2f')}"
+
+
+def _wc_bias() -> tuple[float, int, int]:
+    """Largest |lambda_1 over 10 - lambda_1 over 160| over the checked lanes, how many lie above, how many lanes."""
+    r = _wc()["runs"]
+    d = [a - b for a, b in zip(r["map"]["lyapunov_per_s"], r["long_lyapunov"]["lyapunov_per_s"])]
+    return max(abs(x) for x in d), sum(x > 0 for x in d), len(d)
+
+
+def _gpu_map_f64() -> dict:
+    return next(r for r in _json("docs/performance/gpu_map_kernel.json")["machine_2"] if r.get("dtype") == "float64")
+
+
+QUOTES = [
+    (MAP, lambda: "{} + {} periods (no λ₁) took {:.1f} s on one H100".format(
+        _gpu_map_f64()["transient_periods"], _gpu_map_f64()["sample_periods"], _gpu_map_f64()["run_s"])),
+    (MAP, lambda: "lie up to {:.1f} s⁻¹ from their 160-period values".format(_wc_bias()[0])),
+    (MAP, lambda: "in the {2} lanes checked they lie up to {0:.1f} s⁻¹ from their 160-period values, above them for {1}".format(
+        *_wc_bias())),
+    (MAP, lambda: "{} of {} cells leave the model's validity".format(
+        f"{_map()['regime_counts']['invalid']:,}".replace(",", " "), f"{_map()['cells']:,}".replace(",", " "))),
+    (MAP, lambda: "{} of the {} valid cells are *uncertain*".format(
+        f"{_map()['regime_counts']['uncertain']:,}".replace(",", " "), f"{_map()['lyapunov_cells']:,}".replace(",", " "))),
+    (MAP, lambda: f"{_map()['regime_counts']['chaotic']} are *chaotic*"),
+    (MAP, lambda: "λ₁ ranges from {} to {} s⁻¹ (median {} s⁻¹)".format(
+        *(_m(_map()["lyapunov_per_s"][k], ".2f") for k in ("min", "max", "median")))),
+    (MAP, lambda: "(up to {:.2f} s⁻¹ over 10 periods, but about {:.2f} s⁻¹ over 160 periods in the checked lanes".format(
+        _map()["lyapunov_per_s"]["max"], _wc()["summary"]["chaotic_median_lyapunov_per_s"]["long_lyapunov"])),
+    (MAP, lambda: f"{_map()['unbounded_wandering_cells']} cells show unbounded wandering"),
+    # the window check (also tests/test_docs_numbers.py::test_map_window_check_from_json)
+    (MAP, lambda: "After {} transient periods {} of the {} are period-1 ({} of these were chaotic with the map's windows), "
+        "and over {} periods their λ₁ is {} s⁻¹.".format(
+            _wc()["runs"]["long_transient"]["transient_periods"], len(_wc_periodic()), len(_wc_lanes("low")),
+            sum(_wc()["runs"]["map"]["label_point_estimate"][i] == "chaotic" for i in _wc_periodic()),
+            _wc()["runs"]["long_lyapunov"]["lyapunov_periods"], _wc_range("long_lyapunov", _wc_periodic()))),
+    (MAP, lambda: "stable orbits with |μ_max| {:.3f}–{:.3f}, i.e. Floquet exponents {} to {} s⁻¹ ({:.1f} s for the {})".format(
+        min(o["max_multiplier"] for o in _wc()["floquet"]["orbits"]),
+        max(o["max_multiplier"] for o in _wc()["floquet"]["orbits"]),
+        _m(min(o["floquet_exponent_per_s"] for o in _wc()["floquet"]["orbits"]), ".3f"),
+        _m(max(o["floquet_exponent_per_s"] for o in _wc()["floquet"]["orbits"]), ".3f"),
+        _wc()["floquet"]["seconds"], len(_wc()["floquet"]["orbits"]))),
+    (MAP, lambda: "λ₁ over 10 periods is {} s⁻¹ ({} of {} above the 0.02 s⁻¹ threshold)".format(
+        _wc_range("long_transient", _wc_periodic()),
+        sum(x > 0.02 for x in _wc_values("long_transient", _wc_periodic())), len(_wc_periodic()))),
+    (MAP, lambda: "(standard errors {:.2f}–{:.2f} s⁻¹)".format(
+        min(_wc_values("map", _wc_lanes("low"), "lyapunov_stderr_per_s")),
+        max(_wc_values("map", _wc_lanes("low"), "lyapunov_stderr_per_s")))),
+    (MAP, lambda: "their median λ₁ falls from {:.2f} s⁻¹ over 10 periods to {:.2f} over 40 and {:.3f} over 160 ({} s⁻¹). "
+        "After {} transient periods the 10-period value is again {:.2f} s⁻¹".format(
+            *(_wc()["summary"]["chaotic_median_lyapunov_per_s"][k] for k in ("map", "lyapunov_40", "long_lyapunov")),
+            _wc_range("long_lyapunov", _wc_lanes("chaotic")), _wc()["runs"]["long_transient"]["transient_periods"],
+            _wc()["summary"]["chaotic_median_lyapunov_per_s"]["long_transient"])),
+    (MAP, lambda: "(λ₁ {} s⁻¹)".format(" and ".join(
+        f"{_wc()['runs']['map']['lyapunov_per_s'][i]:.2f} ± {_wc()['runs']['map']['lyapunov_stderr_per_s'][i]:.2f}"
+        for i in _wc_lanes("chaotic") if _wc()["runs"]["map"]["label"][i] == "chaotic"))),
+    (MAP, lambda: "the band's still about {:.0f}× its 160-period value".format(
+        _wc()["summary"]["chaotic_median_lyapunov_per_s"]["lyapunov_40"]
+        / _wc()["summary"]["chaotic_median_lyapunov_per_s"]["long_lyapunov"])),
+    (MAP, lambda: "the {} lanes take {:.1f} s with λ₁ over 10 periods and {:.1f} s over 160".format(
+        len(_wc()["lanes"]), _wc()["runs"]["map"]["seconds"], _wc()["runs"]["long_lyapunov"]["seconds"])),
+]
+
+# ---- docs/orbits/README.md (scripts/orbit_check.py, duffing_cascade.py, bifurcation_grad.py, orbit_branches.py,
+# celt_fold_grad.py; the census, branches and fold values are in core.py)
+
+
+def _orb(name: str) -> dict:
+    return _json(f"docs/orbits/{name}.json")
+
+
+def _branch_seconds(key: str) -> float:
+    return next(iter(_orb("branches")["branches"].values()))["seconds"][key]
+
+
+QUOTES += [
+    (ORBITS, lambda: "| log\\|μ_max\\|/T | {} s⁻¹ |".format(_m(_orb("orbit_check")["floquet_exponent"], ".5f"))),
+    (ORBITS, lambda: "λ₁ on the orbit ({} periods, rtol 1e-10) | {} s⁻¹ ({:.2f} %) |".format(
+        _orb("orbit_check")["lyapunov_periods"], _m(_orb("orbit_check")["lyapunov_lambda1"], ".5f"),
+        100 * _orb("orbit_check")["lyapunov_rel_diff"])),
+    (ORBITS, lambda: "times: the {} branches {:.1f} s with compilation, the scipy diagram {:.1f} s".format(
+        {3: "three"}[len(_orb("duffing_cascade")["branches"])], _orb("duffing_cascade")["seconds"]["continuation_incl_compile"],
+        _orb("duffing_cascade")["seconds"]["brute_force_scipy"])),
+    (ORBITS, lambda: "One located point took {:.1f} s on its first call (compilation included) and {:.1f} s on a repeat call".format(
+        _orb("bifurcation_grad")["seconds_locate_first_call"], _orb("bifurcation_grad")["seconds_locate_second_call"])),
+    (ORBITS, lambda: "1-minute load average {:.2f}–{:.2f}): one Newton solve with the multipliers {:.2f} s; the first corrector "
+        "step {:.1f} s with compilation; then a median {:.2f} s per corrector attempt; the whole branch {:.1f} s".format(
+            min(min(b["load_average"]) for b in _orb("branches")["branches"].values()),
+            max(max(b["load_average"]) for b in _orb("branches")["branches"].values()),
+            _branch_seconds("newton_solve"), _branch_seconds("first_corrector_incl_compile"),
+            _branch_seconds("median_corrector_attempt"), _branch_seconds("branch_incl_compile"))),
+    (ORBITS, lambda: "(1-minute load average {:.1f} at the start and {:.1f} at the end, recorded in the file), every call "
+        "compiling afresh: locate {:.0f} s, gradient {:.0f} s, the two finite-difference locates {:.0f} s.".format(
+            _orb("celt_fold_grad")["load_average_start"][0], _orb("celt_fold_grad")["load_average_end"][0],
+            *(_orb("celt_fold_grad")["seconds"][k] for k in ("locate_incl_compile", "grad_incl_compile", "two_fd_locates_incl_compile")))),
+]
+
+# inputs, not results: the labelling rule's thresholds and the period detector's tolerance
+SETTINGS = [
+    (MAP, "λ₁ − 2 s.e. > 0.02 s⁻¹"),
+    (LABELS, "λ₁ − 2 s.e. > 0.02 s⁻¹"),
+    (LABELS, "λ₁ + 2 s.e. < −0.02 s⁻¹"),
+    (LABELS, "the interval λ₁ ± 2 s.e. reaches across +0.02 or −0.02 s⁻¹"),
+    (LABELS, "within 1e-4 × (1 + max |x|) of sample"),
+    (LABELS, "**0.02 s⁻¹** — the threshold"),
+]
