@@ -17,7 +17,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import time
 from pathlib import Path
@@ -36,6 +35,7 @@ def main():
     import jaxcelt as jc
     from jaxcelt.ensemble import SweepConfig
     from jaxcelt.ensemble import stroboscopic as sb
+    from jaxcelt.provenance import write_result
     from jaxcelt.versions import versions
 
     V = versions()
@@ -91,8 +91,7 @@ def main():
         print("lone lanes, width", w, r, flush=True)
     res["load_average_at_end"] = os.getloadavg()
     if a.out:
-        a.out.mkdir(parents=True, exist_ok=True)
-        (a.out / "drain.json").write_text(json.dumps(res, indent=1))
+        write_result(a.out / "drain.json", res, load_at_start=res["load_average_at_start"])
         print("wrote", a.out / "drain.json")
 
 

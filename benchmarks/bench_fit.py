@@ -155,6 +155,8 @@ def main(argv=None) -> int:
     import optax
     import optimistix
 
+    from jaxcelt.provenance import write_result
+
     def uptime():
         return subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
 
@@ -200,16 +202,22 @@ def main(argv=None) -> int:
         rows += got
         for r in got:
             r["max_iter"] = max_iter
-        a.out.parent.mkdir(parents=True, exist_ok=True)
-        a.out.write_text(json.dumps(meta | {"rows": rows}, indent=1))
+        write_result(a.out, meta | {"rows": rows}, load_at_start=load_at_start(meta))
     meta["uptime_after"] = uptime()
     load = float(meta["uptime_after"].split("load average:")[1].split(",")[0])
     meta["loaded"] = load > 1.5
-    a.out.parent.mkdir(parents=True, exist_ok=True)
-    a.out.write_text(json.dumps(meta | {"rows": rows}, indent=1))
+    write_result(a.out, meta | {"rows": rows}, load_at_start=load_at_start(meta))
     print(f"wrote {a.out}")
     print(table(rows))
     return 0
+
+
+def load_at_start(meta: dict) -> list[float] | None:
+    """The load average in ``uptime`` when the runs began (None where it cannot be read)."""
+    try:
+        return [float(x.strip()) for x in meta["uptime_before"].split("load average:")[1].split(",")[:3]]
+    except (KeyError, IndexError, ValueError):
+        return None
 
 
 def table(rows: list[dict]) -> str:

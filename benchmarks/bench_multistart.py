@@ -69,6 +69,7 @@ def main(argv=None) -> int:
     if a.child:
         print("ROW " + json.dumps(child(a.child, a.starts)), flush=True)
         return 0
+    from jaxcelt.provenance import write_result
     from jaxcelt.versions import versions
 
     out = dict(versions=versions(), cpus=os.cpu_count(), platform=platform.platform(), load_before=os.getloadavg())
@@ -87,8 +88,7 @@ def main(argv=None) -> int:
     out["rows"] = rows
     out["run_ratio_sequential_over_vmapped"] = rows[1]["run_s"] / rows[0]["run_s"]
     out["total_ratio_sequential_over_vmapped"] = rows[1]["call_total_s"] / rows[0]["call_total_s"]
-    a.out.parent.mkdir(parents=True, exist_ok=True)
-    a.out.write_text(json.dumps(out, indent=1))
+    write_result(a.out, out, load_at_start=out["load_before"])
     print(f"wrote {a.out}")
     return 0
 

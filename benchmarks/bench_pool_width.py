@@ -12,7 +12,6 @@ and writes JSON.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import time
 from pathlib import Path
@@ -33,6 +32,7 @@ def main() -> None:
 
     import jaxcelt as jc
     from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
+    from jaxcelt.provenance import write_result
     from jaxcelt.versions import versions
 
     ndev = len(jax.devices())
@@ -57,8 +57,7 @@ def main() -> None:
         res["rows"].append(row)
         print(row, flush=True)
     if a.out is not None:
-        a.out.mkdir(parents=True, exist_ok=True)
-        (a.out / "pool_width.json").write_text(json.dumps(res, indent=1))
+        write_result(a.out / "pool_width.json", res, load_at_start=res["load_average_at_start"])
 
 
 if __name__ == "__main__":

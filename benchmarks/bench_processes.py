@@ -56,6 +56,7 @@ def main() -> None:
     import _numba_model as nm
 
     from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
+    from jaxcelt.provenance import write_result
     from jaxcelt.versions import versions
 
     V = versions()
@@ -128,8 +129,7 @@ def main() -> None:
             flush=True,
         )
     if a.out is not None:
-        a.out.mkdir(parents=True, exist_ok=True)
-        (a.out / "processes.json").write_text(json.dumps(res, indent=1) + "\n")
+        write_result(a.out / "processes.json", res, load_at_start=res["load_average_at_start"])
         print("wrote", a.out / "processes.json")
 
 

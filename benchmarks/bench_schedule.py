@@ -13,7 +13,6 @@ in every configuration (checked here); only the schedule differs.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import time
 from pathlib import Path
@@ -35,6 +34,7 @@ def main() -> None:
     import jaxcelt as jc
     from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
     from jaxcelt.integrate.solvers import make_solver
+    from jaxcelt.provenance import write_result
     from jaxcelt.versions import versions
 
     configs = [(s, int(w), float(f)) for s, w, f in (c.split(":") for c in a.configs.split(","))]
@@ -80,8 +80,7 @@ def main() -> None:
             f"{row['iterations']} iterations, idle slots {row['idle_fraction']:.3f}"
         )
     if a.out is not None:
-        a.out.mkdir(parents=True, exist_ok=True)
-        (a.out / "schedule.json").write_text(json.dumps(res, indent=1))
+        write_result(a.out / "schedule.json", res, load_at_start=res["load_average_at_start"])
 
 
 if __name__ == "__main__":

@@ -15,7 +15,6 @@ whose effect `roofline.py` and `vector_width.py` measure).
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import time
 from pathlib import Path
@@ -127,11 +126,11 @@ def main() -> None:
     for k, v in res["us_per_lane"].items():
         print(f"{k:34s} {v:7.3f} us/lane", flush=True)
     if a.out is not None:
+        from jaxcelt.provenance import write_result
         from jaxcelt.versions import versions
 
         res["versions"] = versions()
-        a.out.mkdir(parents=True, exist_ok=True)
-        (a.out / "step_parts.json").write_text(json.dumps(res, indent=1))
+        write_result(a.out / "step_parts.json", res, load_at_start=res["load_average_at_start"])
 
 
 if __name__ == "__main__":

@@ -39,6 +39,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 import _numba_model as nm  # noqa: E402
 
 import jaxcelt as jc  # noqa: E402
+from jaxcelt.provenance import write_result  # noqa: E402
 from jaxcelt.sweeps.api import bifurcation  # noqa: E402
 from jaxcelt.versions import versions  # noqa: E402
 
@@ -403,7 +404,7 @@ def main():
     print(json.dumps(res["summary"], indent=1), flush=True)
     a.out.mkdir(parents=True, exist_ok=True)
     tag = "quick" if a.quick else f"{a.n_freq}x{a.periods}"
-    (a.out / f"bench_sweep_{tag}.json").write_text(json.dumps(res, indent=1))
+    write_result(a.out / f"bench_sweep_{tag}.json", res, load_at_start=res["load_average_at_start"])
 
     import matplotlib
 

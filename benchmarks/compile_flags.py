@@ -82,8 +82,10 @@ def main() -> None:
     import numpy as np
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from jaxcelt.provenance import load_average, write_result
     from jaxcelt.versions import versions_string
 
+    load0 = load_average()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for rep in range(a.reps):
@@ -125,8 +127,7 @@ def main() -> None:
         rows=rows,
         date=time.strftime("%Y-%m-%d %H:%M:%S"),
     )
-    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(a.out).write_text(json.dumps(out, indent=1))
+    write_result(a.out, out, load_at_start=load0)
     for k, v in summary.items():
         print(f"{k:20s} off {v['off']:8.2f}  on {v['on']:8.2f}  off/on {v['ratio_off_over_on']:.2f}")
     print("samples max |on - off|:", max_diff, "same finite pattern:", same_nan)

@@ -77,6 +77,7 @@ def main(argv=None) -> int:
         return 0
     import numpy as np
 
+    from jaxcelt.provenance import write_result
     from jaxcelt.versions import versions
 
     res: dict = dict(versions=versions(), cpu_count=os.cpu_count(), load_average_at_start=os.getloadavg(), runs={})
@@ -92,8 +93,7 @@ def main(argv=None) -> int:
     res["compile_ratio_loop_over_default"] = res["runs"]["loop"]["compile_s"] / res["runs"]["default"]["compile_s"]
     res["run_ratio_loop_over_default"] = res["runs"]["loop"]["run_best_of_3_s"] / res["runs"]["default"]["run_best_of_3_s"]
     res["load_average_at_end"] = os.getloadavg()
-    a.out.parent.mkdir(parents=True, exist_ok=True)
-    a.out.write_text(json.dumps(res, indent=1))
+    write_result(a.out, res, load_at_start=res["load_average_at_start"])
     print(f"wrote {a.out}: compile x{res['compile_ratio_loop_over_default']:.2f}, run x{res['run_ratio_loop_over_default']:.2f}, "
           f"max |lambda difference| {res['lyapunov_max_abs_diff']:.2e}")  # fmt: skip
     return 0

@@ -70,6 +70,7 @@ def main() -> int:
     if a.child:
         print(json.dumps(child(a.child)))
         return 0
+    from jaxcelt.provenance import write_result
     from jaxcelt.versions import versions
 
     out = {"versions": versions(), "cpu_count": os.cpu_count(), "load_before": os.getloadavg(), "modes": {}}
@@ -86,8 +87,7 @@ def main() -> int:
                 print(mode, runs[-1], flush=True)
         out["modes"][mode] = {"first_process": runs[0], "second_process": runs[1]}
     out["load_after"] = os.getloadavg()
-    a.out.parent.mkdir(parents=True, exist_ok=True)
-    a.out.write_text(json.dumps(out, indent=1) + "\n")
+    write_result(a.out, out, load_at_start=out["load_before"])
     print(f"wrote {a.out}")
     return 0
 

@@ -33,6 +33,7 @@ def main(argv=None) -> int:
     from jaxcelt.identify import program as F
     from jaxcelt.identify.options import FitOptions
     from jaxcelt.identify.problem import build_problem
+    from jaxcelt.provenance import write_result
     from jaxcelt.versions import versions
     paper, _ = paper_and_true()
     data = records()
@@ -63,8 +64,7 @@ def main(argv=None) -> int:
     )
     out["speedup_threads_over_one_program"] = out["best_s"]["one_program_lax_map"] / out["best_s"]["threads"]
     out["load_after"] = os.getloadavg()
-    a.out.parent.mkdir(parents=True, exist_ok=True)
-    a.out.write_text(json.dumps(out, indent=1))
+    write_result(a.out, out, load_at_start=out["load_before"])
     print(json.dumps(out, indent=1))
     return 0
 

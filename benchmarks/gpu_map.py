@@ -4,7 +4,8 @@ One `jaxcelt.parameter_map` of NX x NY lanes from rest, TRANSIENT + SAMPLE forci
 stop-on-invalid (as ``jaxcelt map``), no Lyapunov stage. Compilation is timed apart: the pool's
 kernel is compiled first for the very shapes of the map (``run_lanes(..., compile_only=True)``),
 then the map runs on the compiled kernel. Appends one JSON record per run (versions, device,
-dtype, tolerances, compile and run seconds, lanes/s, step counts, regime counts) to ``--json``
+dtype, tolerances, compile and run seconds, lanes/s, step counts, regime counts, and the run's own
+provenance) to the list ``"runs"`` of ``--json`` (written through `jaxcelt.provenance.write_result`)
 and saves the regime labels (``--labels``, .npz) so that float32 and float64 maps can be compared
 cell by cell.
 
@@ -23,7 +24,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 import time
 from pathlib import Path
@@ -55,7 +55,7 @@ def main() -> int:
     ap.add_argument("--atol", type=float, default=1e-10)
     ap.add_argument("--chunk", type=int, default=None, help="lanes per pool launch (default: all)")
     ap.add_argument("--width", type=int, default=None, help="pool slots (default: the chunk, no queue)")
-    ap.add_argument("--json", type=Path, default=Path("out/gpu_map.json"), help="JSON list to append a record to")
+    ap.add_argument("--json", type=Path, default=Path("out/gpu_map.json"), help="JSON file whose 'runs' list gets the record")
     ap.add_argument("--labels", type=Path, default=None, help=".npz of the map's categories and status")
     ap.add_argument("--compare", nargs=2, type=Path, default=None, help="compare two --labels files and exit")
     ap.add_argument("--engine", default="auto", choices=("auto", "pool", "kernel"))
@@ -82,8 +82,10 @@ def main() -> int:
     import jaxcelt as jc
     from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
     from jaxcelt.plotting.map import map_categories
+    from jaxcelt.provenance import load_average
     from jaxcelt.versions import versions
 
+    load0 = load_average()
     ver = versions()
     print(json.dumps(ver), flush=True)
     p = jc.CeltParams.paper()
@@ -141,7 +143,7 @@ def main() -> int:
         "regime_counts": {label: int(np.sum(cat == i)) for i, (label, _) in enumerate(cats) if np.any(cat == i)},
     }
     print(json.dumps(rec), flush=True)
-    _append(a.json, rec)
+    _append(a.json, rec, load_at_start=load0)
     if a.labels:
         a.labels.parent.mkdir(parents=True, exist_ok=True)
         np.savez_compressed(a.labels, category=cat, status=status, omega_pi=xs, q_pi=ys)
@@ -196,13 +198,14 @@ def check(a) -> dict:
     return rec
 
 
-def _append(path: Path, rec: dict) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    recs = json.loads(path.read_text()) if path.exists() else []
-    recs.append(rec)
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(json.dumps(recs, indent=1) + "\n")
-    os.replace(tmp, path)
+def _append(path: Path, rec: dict, load_at_start: list[float] | None = None) -> None:
+    from jaxcelt.provenance import provenance, write_result
+
+    recs = json.loads(path.read_text()) if path.exists() else {"runs": []}
+    recs = recs if isinstance(recs, list) else recs["runs"]  # a list: a file of the script's earlier versions
+    # each record keeps its own run's provenance: the file gathers runs of several processes (and machines)
+    recs.append(rec | {"provenance": provenance(load_at_start=load_at_start)})
+    write_result(path, {"runs": recs}, load_at_start=load_at_start)
 
 
 if __name__ == "__main__":

@@ -68,6 +68,7 @@ def main(argv=None) -> int:
     backend_start_s = time.perf_counter() - t
 
     from jaxcelt.cli import main as cli
+    from jaxcelt.provenance import write_result
     from jaxcelt.versions import versions
 
     logged: list[tuple[str, float]] = []
@@ -119,8 +120,7 @@ def main(argv=None) -> int:
     res["command_compile_overhead_s"] = first["command_s"] - second["command_s"]
     res["same_regimes"] = first["regimes"] == second["regimes"]
     res["load_average_at_end"] = os.getloadavg()
-    a.out.parent.mkdir(parents=True, exist_ok=True)
-    a.out.write_text(json.dumps(res, indent=1))
+    write_result(a.out, res, load_at_start=res["load_average_at_start"])
     print(json.dumps({k: v for k, v in res.items() if k != "runs"}, indent=1))
     for r in res["runs"]:
         print(f"command {r['command_s']:.1f} s, sweep {r['sweep_s']:.1f} s; logged: {r['logged_over_0_2_s']}")
@@ -149,8 +149,9 @@ def _repeated(out: Path, reps: int) -> int:
     res["imports_s_median"] = statistics.median(r["imports_s"] for r in each)
     res["backend_start_s_median"] = statistics.median(r["backend_start_s"] for r in each)
     res["versions"] = each[0]["versions"]
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(res, indent=1))
+    from jaxcelt.provenance import write_result
+
+    write_result(out, res, load_at_start=each[0]["load_average_at_start"])
     print({k: v for k, v in res.items() if k != "reps"})
     return 0
 

@@ -100,8 +100,10 @@ def main() -> int:
     import jax
 
     import jaxcelt as jc
+    from jaxcelt.provenance import load_average, write_result
     from jaxcelt.versions import versions
 
+    load0 = load_average()
     ver = versions()
     print(json.dumps(ver), flush=True)
     p = jc.CeltParams.paper()
@@ -177,8 +179,7 @@ def main() -> int:
         }
         # no projection in seconds: an implicit step costs other than the measured Tsit5 iterations
     print(json.dumps(rec, indent=1), flush=True)
-    a.json.parent.mkdir(parents=True, exist_ok=True)
-    a.json.write_text(json.dumps(rec, indent=1) + "\n")
+    write_result(a.json, rec, load_at_start=load0)
     return 0
 
 

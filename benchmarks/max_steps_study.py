@@ -15,7 +15,6 @@ lanes that are expensive for any of them. Steps per lane and statuses go to a JS
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from pathlib import Path
@@ -28,6 +27,7 @@ import _numba_model as nm  # noqa: E402
 import diffrax  # noqa: E402
 
 import jaxcelt as jc  # noqa: E402
+from jaxcelt.provenance import load_average, write_result  # noqa: E402
 from jaxcelt.versions import versions  # noqa: E402
 
 
@@ -67,6 +67,7 @@ def main():
     ap.add_argument("--top", type=int, default=24, help="lanes re-run with jaxcelt: the costliest for numba DP5")
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
+    load0 = load_average()
     rtol, atol = 1e-8, 1e-10
     p = jc.CeltParams.paper()
     vals = np.linspace(10.0, 20.0, a.n_freq)
@@ -108,8 +109,7 @@ def main():
     for r in rows:
         print(f"{r['omega_pi']:9.4f} " + " ".join(f"{s:>11d}/{c}" for s, c in (r["numba_dp5"], r["numba_tsit5"], r["jaxcelt_tsit5"], r["jaxcelt_dopri5"])))  # fmt: skip
     if a.out:
-        Path(a.out).mkdir(parents=True, exist_ok=True)
-        (Path(a.out) / "max_steps_study.json").write_text(json.dumps(res, indent=1))
+        write_result(Path(a.out) / "max_steps_study.json", res, load_at_start=load0)
 
 
 if __name__ == "__main__":

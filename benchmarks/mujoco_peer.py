@@ -30,7 +30,6 @@ tilt against time, MuJoCo vs jaxcelt); (``--parts mjx``): ``mujoco_mjx.json``, M
 from __future__ import annotations
 
 import argparse
-import json
 import pathlib
 import sys
 import time
@@ -44,6 +43,7 @@ from mujoco import rollout
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import jaxcelt as jc  # noqa: E402
+from jaxcelt.provenance import load_average, write_result  # noqa: E402
 from jaxcelt.studies import benchmarking as bm  # noqa: E402
 from jaxcelt.versions import versions  # noqa: E402
 
@@ -191,6 +191,7 @@ def main(argv=None):
     ap.add_argument("--parts", default="scenes,mjx")
     args = ap.parse_args(argv)
     out = pathlib.Path(args.out)
+    load0 = load_average()
     info = versions()
     info.update(device=bm.device_string(), mujoco=mujoco.__version__)
     try:
@@ -232,13 +233,13 @@ def main(argv=None):
             for r in sc["runs"]:
                 k = -(-len(r["t"]) // 500)
                 r.update({a: r[a][::k] for a in ("t", "omega_s", "tilt")})
-        (out / "mujoco.json").write_text(json.dumps(res, separators=(",", ":"), default=float))
+        write_result(out / "mujoco.json", res, load_at_start=load0, indent=None, default=float)
     if "mjx" in parts:
         T_mjx = args.mjx_periods * 2 * np.pi / 17.0
         desc = f"rest17, {args.mjx_periods} periods ({T_mjx:.3f} s), dt 2e-3, initial spin + N(0, 0.05^2) rad/s"
         print(f"MJX scaling: {desc}", flush=True)
         mjx_rows = mjx_scaling(p17, T_mjx, 2e-3, [int(x) for x in args.mjx_lanes.split(",")], args.budget)
-        (out / "mujoco_mjx.json").write_text(json.dumps(dict(versions=info, scene=desc, mjx=mjx_rows), indent=1))
+        write_result(out / "mujoco_mjx.json", dict(versions=info, scene=desc, mjx=mjx_rows), load_at_start=load0)
     return res
 
 

@@ -38,6 +38,7 @@ import _numba_model as nm  # noqa: E402
 
 import jaxcelt as jc  # noqa: E402
 from jaxcelt.integrate import solvers  # noqa: E402
+from jaxcelt.provenance import write_result  # noqa: E402
 from jaxcelt.studies import benchmarking as bm  # noqa: E402
 from jaxcelt.versions import versions  # noqa: E402
 
@@ -338,7 +339,7 @@ def main(argv=None):
         scaling_skipped=skipped,
     )
     tag = "_quick" if args.quick else ""
-    (out / f"peers{tag}.json").write_text(json.dumps(res, indent=1, default=float))
+    write_result(out / f"peers{tag}.json", res, load_at_start=info["loadavg_start"], default=float)
     from jaxcelt.plotting.performance import plot_peers
 
     plot_peers(tables[0]).savefig(out / f"peers{tag}.png", dpi=110)

@@ -19,7 +19,6 @@ however tight the tolerance: that is reported, not hidden.
 from __future__ import annotations
 
 import argparse
-import json
 import pathlib
 import sys
 import time
@@ -31,6 +30,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 import jaxcelt as jc  # noqa: E402
 from jaxcelt.integrate import solvers  # noqa: E402
+from jaxcelt.provenance import write_result  # noqa: E402
 from jaxcelt.studies import benchmarking as bm  # noqa: E402
 from jaxcelt.versions import versions  # noqa: E402
 
@@ -135,7 +135,7 @@ def main(argv=None):
         )
     tag = "_quick" if args.quick else ""
     path = out / f"reference{tag}.json"
-    path.write_text(json.dumps(dict(versions=info, results=results), indent=1))
+    write_result(path, dict(versions=info, results=results))
     print("wrote", path)
     try:
         from jaxcelt.plotting.performance import plot_reference_agreement

@@ -73,6 +73,7 @@ def main():
     from jaxcelt._compile_options import pool_compiler_options
     from jaxcelt.physics.contact.registry import get_contact_law
     from jaxcelt.physics.model import vector_field
+    from jaxcelt.provenance import write_result
     from jaxcelt.versions import versions
 
     p = jc.CeltParams.paper()
@@ -161,8 +162,7 @@ def main():
     }
     print(json.dumps(res, indent=1))
     if a.out:
-        Path(a.out).mkdir(parents=True, exist_ok=True)
-        (Path(a.out) / "roofline.json").write_text(json.dumps(res, indent=1))
+        write_result(Path(a.out) / "roofline.json", res, load_at_start=res["load_average_at_start"])
     return 0
 
 

@@ -47,6 +47,7 @@ import jaxcelt as jc
 from jaxcelt.integrate import solvers
 from jaxcelt.integrate.lyapunov import celt_lyapunov
 from jaxcelt.plotting import results
+from jaxcelt.provenance import write_result
 from jaxcelt.studies import benchmarking as bm
 from jaxcelt.sweeps.regimes import classify, regime_names
 from jaxcelt.versions import versions
@@ -61,6 +62,7 @@ class Part:
         self.name, self.path, self.budget = name, out / f"stability_{name}.json", budget
         self.t0 = time.perf_counter()
         self.res = dict(meta, part=name, rows=[], part_budget_s=budget)
+        self.load_at_start = meta.get("versions", {}).get("loadavg_at_start")
         self.compiled = set()
 
     @property
@@ -71,13 +73,16 @@ class Part:
         self.res["rows"].append(row)
         self.res["elapsed_s"] = time.perf_counter() - self.t0
         self.res["maxrss_MB"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-        self.path.write_text(json.dumps(self.res, indent=1, default=_json_default))
+        self.write()
         if msg:
             print(f"({self.name}) {msg}", flush=True)
 
     def set(self, key, val):
         self.res[key] = val
-        self.path.write_text(json.dumps(self.res, indent=1, default=_json_default))
+        self.write()
+
+    def write(self):
+        write_result(self.path, self.res, load_at_start=self.load_at_start, default=_json_default)
 
 
 def _json_default(x):

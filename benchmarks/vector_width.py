@@ -90,6 +90,7 @@ def main() -> int:
     sys.path.insert(0, str(HERE))
     from roofline import cpu_facts
 
+    from jaxcelt.provenance import write_result
     from jaxcelt.versions import versions
 
     V = versions()
@@ -122,8 +123,7 @@ def main() -> int:
         print(mode, json.dumps(med), flush=True)
     res["load_average_at_end"] = os.getloadavg()
     if a.out is not None:
-        a.out.mkdir(parents=True, exist_ok=True)
-        (a.out / "vector_width.json").write_text(json.dumps(res, indent=1))
+        write_result(a.out / "vector_width.json", res, load_at_start=res["load_average_at_start"])
         print("wrote", a.out / "vector_width.json")
     return 0
 

@@ -33,6 +33,7 @@ import optimistix as optx
 
 import jaxcelt as jc
 from jaxcelt.integrate import solvers
+from jaxcelt.provenance import load_average, write_result
 from jaxcelt.studies import benchmarking as bm
 from jaxcelt.versions import versions
 
@@ -280,6 +281,7 @@ def main(argv=None):
     if args.report:
         print(report(json.loads(path.read_text())))
         return None
+    load0 = load_average()
     info = versions()
     info["device"] = bm.device_string()
     print("versions:", info, flush=True)
@@ -298,7 +300,7 @@ def main(argv=None):
     refs: dict = {}
 
     def save():
-        path.write_text(json.dumps(res, indent=1))
+        write_result(path, res, load_at_start=load0)
 
     def out_of_time():
         return (time.perf_counter() - t_start) / 60 > args.deadline_min

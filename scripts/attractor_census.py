@@ -26,6 +26,7 @@ import jax
 import numpy as np
 
 import jaxcelt as jc
+from jaxcelt.provenance import write_result
 
 ROOT = Path(__file__).resolve().parents[1]
 OMEGAS = (14.0, 15.6, 17.0, 19.0)
@@ -190,12 +191,12 @@ def main(argv=None) -> None:
             d = run_one(w, args)
             d["request"] = want
             (out / "census" / f"basins_{_name(w)}.png").unlink(missing_ok=True)
-            f.write_text(json.dumps(d))
+            write_result(f, d, load_at_start=d["load_average_start"], indent=None)
             print(f"omega_pi = {w:g}: {d['wall_s']} s, " + ", ".join(
                 f"{a['name']} {a['fraction']:.3f}" for a in d["attractors"]), flush=True)  # fmt: skip
         if args.refine_stored:
             refine_stored(w, d)
-            f.write_text(json.dumps(d))
+            write_result(f, d, indent=None)
         png = out / "census" / f"basins_{_name(w)}.png"
         if not png.exists():
             try:
@@ -219,7 +220,7 @@ def main(argv=None) -> None:
             d.pop("lanes", None)
             summary["omega_pi"].append(w)
             summary["results"][f"{w:g}"] = d
-    (out / "census.json").write_text(json.dumps(summary, indent=1))
+    write_result(out / "census.json", summary)
 
 
 if __name__ == "__main__":

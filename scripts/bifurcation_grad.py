@@ -12,6 +12,7 @@ import numpy as np
 
 from jaxcelt.orbits.points import locate_period_doubling
 from jaxcelt.orbits.shooting import stroboscopic_map
+from jaxcelt.provenance import load_average, write_result
 from jaxcelt.versions import versions
 
 OMEGA, DELTA, H = 1.2, 0.3, 1e-4
@@ -24,6 +25,7 @@ def duffing(t, y, a):
 
 
 def main() -> None:
+    load0 = load_average()
     y = jnp.array([1.0, 0.0])
     for _ in range(60):
         y, _, _ = stroboscopic_map(duffing, y, (0.26, DELTA), period=T, rtol=1e-9, atol=1e-10)
@@ -59,7 +61,7 @@ def main() -> None:
         "versions": versions(),
     }
     path = pathlib.Path(__file__).resolve().parents[1] / "docs/orbits/bifurcation_grad.json"
-    path.write_text(json.dumps(out, indent=2) + "\n")
+    write_result(path, out, load_at_start=load0, indent=2)
     print(json.dumps({k: v for k, v in out.items() if k != "versions"}, indent=2))
 
 

@@ -25,6 +25,7 @@ import numpy as np
 import jaxcelt as jc
 from jaxcelt.orbits.celt import locate_orbit_bifurcation
 from jaxcelt.physics.model import STATE_NAMES
+from jaxcelt.provenance import write_result
 from jaxcelt.versions import versions
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -88,7 +89,7 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=pathlib.Path, default=ROOT / "docs/orbits/celt_fold_grad.json")
     a = ap.parse_args(argv)
     out = check(a.h)
-    a.out.write_text(json.dumps(out, indent=2) + "\n")
+    write_result(a.out, out, load_at_start=out["load_average_start"], indent=2)
     print(json.dumps({k: v for k, v in out.items() if k != "versions"}, indent=2))
     return 0
 

@@ -12,7 +12,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import pathlib
 import time
 
@@ -29,6 +28,7 @@ from jaxcelt.integrate.noslip import simulate_noslip  # noqa: E402
 from jaxcelt.physics.contact.calibrate import _with, calibrate, error_map, integral_reference, slip_samples  # noqa: E402
 from jaxcelt.physics.contact.integral import HERTZ_S, patch_integrals  # noqa: E402
 from jaxcelt.plotting.contact import plot_convergence, plot_cost_vs_error, plot_error_maps  # noqa: E402
+from jaxcelt.provenance import load_average, write_result  # noqa: E402
 from jaxcelt.studies.ladder import HERTZ_CALIBRATED, builtin_scenes, needed_state, recommend, results_table, run_ladder  # noqa: E402
 
 OUT = pathlib.Path(__file__).resolve().parents[1] / "docs" / "contact"
@@ -165,6 +165,7 @@ def main():
     ap.add_argument("--skip-ladder", action="store_true")
     args = ap.parse_args()
     OUT.mkdir(parents=True, exist_ok=True)
+    load0 = load_average()
     summary = {"jax": jax.__version__}
     for name, fn in (("convergence", convergence), ("limits", limits), ("kane_levinson", kane_levinson)):
         t = time.time()
@@ -173,10 +174,10 @@ def main():
     t = time.time()
     summary["calibration"], summary["error_maps"] = calibration()
     print(f"calibration: {time.time() - t:.0f} s", flush=True)
-    (OUT / "summary.json").write_text(json.dumps(summary, indent=1, default=float))
+    write_result(OUT / "summary.json", summary, load_at_start=load0, default=float)
     if not args.skip_ladder:
         summary["ladder"] = ladder(args.short)
-        (OUT / "summary.json").write_text(json.dumps(summary, indent=1, default=float))
+        write_result(OUT / "summary.json", summary, load_at_start=load0, default=float)
         print(summary["ladder"]["table"])
 
 

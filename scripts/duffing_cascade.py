@@ -27,6 +27,7 @@ from scipy.integrate import solve_ivp
 
 from jaxcelt.orbits.branch import continue_arclength
 from jaxcelt.orbits.switching import switch_at_period_doubling
+from jaxcelt.provenance import load_average, write_result
 from jaxcelt.versions import versions
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -117,6 +118,7 @@ def main(argv=None) -> int:
     ap.add_argument("--grid", type=int, default=383, help="brute-force values of F in [0.255, 0.2932]")
     ap.add_argument("--out", type=pathlib.Path, default=ROOT / "docs/orbits")
     a = ap.parse_args(argv)
+    load0 = load_average()
     t = time.perf_counter()
     pds, branches = cascade()
     t_cont = time.perf_counter() - t
@@ -158,7 +160,7 @@ def main(argv=None) -> int:
         "versions": versions(),
         "branches": branches,
     }
-    (a.out / "duffing_cascade.json").write_text(json.dumps(res, indent=1) + "\n")
+    write_result(a.out / "duffing_cascade.json", res, load_at_start=load0)
     print(json.dumps({k: v for k, v in res.items() if k not in ("versions", "branches")}, indent=2))
 
     import matplotlib

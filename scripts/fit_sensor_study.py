@@ -27,6 +27,7 @@ import numpy as np
 import jaxcelt as jc
 from jaxcelt.identify.records import generate_data
 from jaxcelt.identify.strategies import fit_staged
+from jaxcelt.provenance import load_average, write_result
 from jaxcelt.versions import versions
 
 FREE = ("mu", "k_r", "b_Ts", "m_Ts")
@@ -109,6 +110,7 @@ def main() -> int:
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--out", type=Path, default=Path("docs/fit/sensor_study.json"))
     a = ap.parse_args()
+    load0 = load_average()
     prev = json.loads(a.out.read_text()) if a.out.exists() else {}
     rows = [r for r in prev.get("rows", []) if r["seed"] < a.seeds]
     done = {r["seed"] for r in rows}
@@ -124,17 +126,12 @@ def main() -> int:
             truth=dict(rotation_vector=ROTATION.tolist(), time_offset=OFFSETS.tolist(), releases=RELEASES),
             rows=sorted(rows, key=lambda r: r["seed"]), summary=summarize(rows),
         )  # fmt: skip
-        a.out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = a.out.with_suffix(".tmp")
-        tmp.write_text(json.dumps(rec, indent=1) + "\n")
-        os.replace(tmp, a.out)
+        write_result(a.out, rec, load_at_start=load0)
     rec = json.loads(a.out.read_text())
     if "whole_record_fit_seed0" not in rec:  # the same problem without stages, for comparison
         r = one(0, spans=(1.0,))
         rec["whole_record_fit_seed0"] = {k: r[k] for k in ("converged", "n_iter", "s2", "rel_err", "values")}
-        tmp = a.out.with_suffix(".tmp")
-        tmp.write_text(json.dumps(rec, indent=1) + "\n")
-        os.replace(tmp, a.out)
+        write_result(a.out, rec, load_at_start=load0)
     print(json.dumps(rec["summary"], indent=1))
     print("whole record, seed 0:", json.dumps(rec["whole_record_fit_seed0"]))
     return 0

@@ -23,6 +23,7 @@ import jaxcelt as jc
 import jaxcelt.identify as F
 import jaxcelt.identify.records as D
 from jaxcelt.plotting import fit as FP
+from jaxcelt.provenance import write_result
 
 FREE = ("mu", "k_r", "b_Ts", "m_Ts")
 PAPER = jc.CeltParams.paper()
@@ -70,16 +71,14 @@ def recover(out):
         print(kinds, res.summary(), flush=True)
         rows.append(row(res, "+".join(kinds)) | {"corr": np.asarray(res.corr).tolist()})
         results[kinds[0]] = res
-    (out / "recover.json").write_text(
-        json.dumps(
-            dict(
-                true=true_dict(),
-                start={n: float(getattr(PAPER, n)) for n in FREE},
-                record="1 s, 100 Hz, omega_pi=17, 10 deg tilt, spin 5 rad/s",
-                rows=rows,
-            ),
-            indent=1,
-        )
+    write_result(
+        out / "recover.json",
+        dict(
+            true=true_dict(),
+            start={n: float(getattr(PAPER, n)) for n in FREE},
+            record="1 s, 100 Hz, omega_pi=17, 10 deg tilt, spin 5 rad/s",
+            rows=rows,
+        ),
     )
     FP.plot_fit(results["omega"], title="IMU-only fit (noise-free)", true=TRUE).savefig(
         out / "recover_imu.png", dpi=110
@@ -105,11 +104,10 @@ def compare(out):
         print(opt, res.summary(), flush=True)
         rows.append(row(res, opt) | {"max_iter": kw["max_iter"], "max_time_s": kw["max_time"]})
         results.append(res)
-        (out / "compare_partial.json").write_text(json.dumps(rows, indent=1))
-    (out / "compare.json").write_text(
-        json.dumps(
-            dict(problem="IMU (omega) 1 s at 100 Hz, 1% noise, seed 123, start: paper values", rows=rows), indent=1
-        )
+        write_result(out / "compare_partial.json", {"rows": rows})  # the optimisers done so far
+    write_result(
+        out / "compare.json",
+        dict(problem="IMU (omega) 1 s at 100 Hz, 1% noise, seed 123, start: paper values", rows=rows),
     )
     FP.plot_loss_histories(results, [r.optimiser for r in results]).savefig(out / "compare_loss.png", dpi=110)
     FP.plot_parameter_traces(results, [r.optimiser for r in results], true=TRUE).savefig(
@@ -152,7 +150,7 @@ def coverage(out, seeds):
     frac = {n: float(np.mean([r["covers"][n] for r in rows])) for n in FREE}
     all_in = float(np.mean([all(r["covers"].values()) for r in rows]))
     summary = dict(seeds=seeds, per_parameter_coverage=frac, joint_all_four_inside=all_in, true=true_dict(), rows=rows)
-    (out / "coverage.json").write_text(json.dumps(summary, indent=1))
+    write_result(out / "coverage.json", summary)
     print("coverage", frac, "all four inside:", all_in)
     FP.plot_coverage(rows, TRUE, FREE).savefig(out / "coverage.png", dpi=110)
 
@@ -259,7 +257,7 @@ def chaos_record(out):
         res["fd_log_separation_per_period"][19],
         res["fd_log_separation_per_period"][-1],
     )
-    (out / "chaos_record.json").write_text(json.dumps(res, indent=1))
+    write_result(out / "chaos_record.json", res)
     plot_chaos_record(out)
 
 
@@ -322,16 +320,14 @@ def _chaos_fit(out, label, tag, optimiser="lm", **kw):
     r["covers"] = res.covers(truth)
     r["loss_history"] = res.loss_history
     r["settings"] = {k: v for k, v in (CHAOS_FIT | kw).items()}
-    (out / f"chaos_{tag}.json").write_text(
-        json.dumps(
-            dict(
-                record=_chaos_record_text(),
-                start="TRUE values of the study (mu 0.3137, k_r 0.2607, b_Ts 0.7958, m_Ts 1.1017)",
-                truth={n: float(getattr(truth, n)) for n in FREE},
-                row=r,
-            ),
-            indent=1,
-        )
+    write_result(
+        out / f"chaos_{tag}.json",
+        dict(
+            record=_chaos_record_text(),
+            start="TRUE values of the study (mu 0.3137, k_r 0.2607, b_Ts 0.7958, m_Ts 1.1017)",
+            truth={n: float(getattr(truth, n)) for n in FREE},
+            row=r,
+        ),
     )
     plot_chaos_fit(out, tag)
     return res
@@ -438,7 +434,7 @@ def gradnorm(out):
             time_s=time.perf_counter() - t,
         )
         print(tag, f"{time.perf_counter() - t:.1f}s", "g at 1 period, end:", g[CHAOS_SPP - 1], g[-1], flush=True)
-    (out / "gradnorm.json").write_text(json.dumps(res, indent=1))
+    write_result(out / "gradnorm.json", res)
     plot_gradnorm(out)
 
 

@@ -31,6 +31,7 @@ def main() -> int:
 
     import jaxcelt as jc
     from jaxcelt.plotting.map import map_categories
+    from jaxcelt.provenance import load_average, write_result
     from jaxcelt.sweeps.api import sweep_lanes
     from jaxcelt.sweeps.regimes import REGIMES
     from jaxcelt.versions import versions
@@ -49,6 +50,7 @@ def main() -> int:
         "float32_rtol1e-6": dict(rtol=1e-6, atol=1e-8, dtype="float32"),
     }
     res, secs = {}, {}
+    load0 = load_average()
     for name, opts in runs.items():
         t = time.perf_counter()
         res[name] = sweep_lanes(p, {"omega_pi": om, "q_pi": q}, **kw, **opts)
@@ -69,7 +71,7 @@ def main() -> int:
             }
         cells.append(row)
     out = {"about": __doc__.splitlines()[0], "versions": versions(), "seconds": secs, "cells": cells}
-    a.out.write_text(json.dumps(out, indent=1) + "\n")
+    write_result(a.out, out, load_at_start=load0)
     print(json.dumps(cells, indent=1))
     return 0
 

@@ -50,9 +50,11 @@ def main() -> int:
     a = ap.parse_args()
 
     import jaxcelt as jc
+    from jaxcelt.provenance import load_average, write_result
     from jaxcelt.sweeps.regimes import classify, regime_names
     from jaxcelt.versions import versions
 
+    load0 = load_average()
     p = jc.CeltParams.paper()
     pts = LOW + CHAOTIC
     lanes = {"omega_pi": np.array([w for w, _ in pts]), "q_pi": np.array([q for _, q in pts])}
@@ -142,8 +144,7 @@ def main() -> int:
         "low_median_lyapunov_per_s": {run: med(run, low) for run in RUNS},
     }
     print(json.dumps(rec["summary"]), flush=True)
-    a.json.parent.mkdir(parents=True, exist_ok=True)
-    a.json.write_text(json.dumps(rec, indent=1) + "\n")
+    write_result(a.json, rec, load_at_start=load0)
     return 0
 
 

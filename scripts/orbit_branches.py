@@ -30,6 +30,7 @@ import jaxcelt as jc
 from jaxcelt.orbits.branch import ArclengthBranch, branch_to_dict
 from jaxcelt.orbits.points import Bifurcation
 from jaxcelt.physics.model import STATE_NAMES
+from jaxcelt.provenance import write_result
 from jaxcelt.versions import versions
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -61,12 +62,6 @@ def _branch_from_dict(d: dict) -> ArclengthBranch:
         stopped=d["stopped"],
         start=d["start"],
     )
-
-
-def _write(path: Path, data: dict) -> None:
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(json.dumps(data, indent=1))
-    os.replace(tmp, path)
 
 
 def main(argv=None) -> int:
@@ -146,7 +141,7 @@ def main(argv=None) -> int:
             },
             "load_average": [round(load0, 2), round(os.getloadavg()[0], 2)],
         }
-        _write(out_json, res)
+        write_result(out_json, res)
         print(f"{label}: {len(br.values)} points, {br.stopped}, {t_branch:.1f} s")
         for b in br.bifurcations:
             print(f"   {b.kind} at {b.value:.6f}: |mu| " + ", ".join(f"{x:.5f}" for x in np.abs(b.multipliers[:3])))
@@ -190,7 +185,7 @@ def main(argv=None) -> int:
             f"{r['status']}, {'stable' if r['stable'] else 'unstable'}, |mu|max {r['multipliers_abs'][0]:.5f}" for r in rows
         ))  # fmt: skip
     res["paper_frequencies"] = at
-    _write(out_json, res)
+    write_result(out_json, res)
 
     # brute force from rest at psi0 = 157.5 deg
     p = jc.CeltParams.paper()
@@ -212,7 +207,7 @@ def main(argv=None) -> int:
         "seconds_incl_compile": round(time.perf_counter() - t, 1),
         "lanes_invalid": int(np.sum(~np.asarray(sw.valid))),
     }
-    _write(out_json, res)
+    write_result(out_json, res)
 
     import matplotlib
 

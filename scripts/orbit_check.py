@@ -26,6 +26,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 import jaxcelt as jc
+from jaxcelt.provenance import load_average, write_result
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))  # the independent reference model lives with the tests
@@ -119,9 +120,9 @@ def main(argv=None):
     ap.add_argument("--out", default=str(ROOT / "docs" / "orbits" / "orbit_check.json"))
     ap.add_argument("--periods", type=int, default=1000, help="periods of the Lyapunov average")
     a = ap.parse_args(argv)
+    load0 = load_average()
     r = check(a.periods)
-    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(a.out).write_text(json.dumps(r, indent=1) + "\n")
+    write_result(a.out, r, load_at_start=load0)
     print(json.dumps({k: v for k, v in r.items() if k != "y"}, indent=1))
 
 

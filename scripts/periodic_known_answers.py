@@ -30,6 +30,9 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=str(ROOT / "docs" / "orbits" / "known_answers.json"))
     a = ap.parse_args(argv)
+    from jaxcelt.provenance import load_average, write_result
+
+    load0 = load_average()
     r = {"load_average": os.getloadavg()[0]}
     d, w0, F, w = 0.3, 1.5, 0.7, 2.1
     T = 2 * np.pi / w
@@ -84,7 +87,7 @@ def main(argv=None):
         orbit_max_error_vs_scipy=float(np.max(np.abs(od.y[:2] - ref))),
         det_minus_exp_dT=float(np.max(np.abs(np.prod(od.multipliers[:2], axis=1).real - np.exp(-dd * TT)))),
     )
-    Path(a.out).write_text(json.dumps(r, indent=1) + "\n")
+    write_result(a.out, r, load_at_start=load0)
     print(json.dumps(r, indent=1))
 
 
