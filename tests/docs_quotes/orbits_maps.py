@@ -145,6 +145,59 @@ QUOTES += [
             *(_orb("celt_fold_grad")["seconds"][k] for k in ("locate_incl_compile", "grad_incl_compile", "two_fd_locates_incl_compile")))),
 ]
 
+# ---- docs/paper-reproduction.md (scripts/paper_study.py, scripts/paper_figures.py; the starts, the 14 rad/s range over
+# all files and the figures' times are in core.py)
+
+
+def _study(tag: str) -> dict:
+    return _json(f"docs/paper-reproduction/study_{tag}.json")
+
+
+def _row(tag: str, ic: str, omega: float, **match) -> dict:
+    return next(r for r in _study(tag)["rows"] if r["ic"] == ic and r["omega_pi"] == omega
+                and all(r[k] == v for k, v in match.items()))
+
+
+def _headings(omega: float, degs=None) -> list[dict]:
+    rows = [r for r in _study("headings_eps1e-4")["rows"] if r["omega_pi"] == omega]
+    return [r for r in rows if degs is None or float(r["ic"].removeprefix("rest psi0=").removesuffix("deg")) in degs]
+
+
+def _ceil2(x: float) -> float:
+    import math
+
+    return math.ceil(100 * x) / 100
+
+
+QUOTES += [
+    (PAPER, lambda: "the heading study's standard error for the same lane ({:.3f} s⁻¹)".format(
+        _row("headings_eps1e-4", "rest psi0=157.5deg", 17.0)["lyapunov_stderr"])),
+    (PAPER, lambda: "17 rad/s at ψ0 = 90° has λ₁ = {:.2f} s⁻¹ here and {:.3f} s⁻¹ over {} periods".format(
+        _row("stageA", "rest psi0=pi/2", 17.0, v_pi_sign=1.0, derivative_exact=0.0)["lyapunov"],
+        _row("headings_eps1e-4", "rest psi0=90deg", 17.0)["lyapunov"], _study("headings_eps1e-4")["config"]["lyapunov"])),
+    (PAPER, lambda: "give an exponent within {:.2f} s⁻¹ of zero".format(
+        _ceil2(max(abs(r["lyapunov"]) for r in _headings(17.0, {90, 112.5, 135, 157.5, 270, 292.5, 315, 337.5}))))),
+    (PAPER, lambda: "0°, 180° and 202.5° are {} with λ₁ of {:.2f}–{:.2f} s⁻¹".format(
+        "/".join(sorted({r["allowed"] for r in _headings(17.0, {0, 180, 202.5})})),
+        min(r["lyapunov"] for r in _headings(17.0, {0, 180, 202.5})),
+        max(r["lyapunov"] for r in _headings(17.0, {0, 180, 202.5})))),
+    (PAPER, lambda: "At 14 rad/s every heading is {} (λ₁ = {:.2f}–{:.2f} s⁻¹)".format(
+        " or ".join(sorted({r["allowed"] for r in _headings(14.0)})),
+        min(r["lyapunov"] for r in _headings(14.0)), max(r["lyapunov"] for r in _headings(14.0)))),
+    (PAPER, lambda: "{:.2f}–{:.2f} s⁻¹ in the heading study B".format(
+        min(r["lyapunov"] for r in _headings(14.0)), max(r["lyapunov"] for r in _headings(14.0)))),
+    (PAPER, lambda: "transient {} periods (≈ {:.0f}–{:.0f} s of motion)".format(
+        _study("long2000")["config"]["transient"],
+        *(round(_study("long2000")["config"]["transient"] * 2 * 3.141592653589793 / w, -1)
+          for w in (max(r["omega_pi"] for r in _study("long2000")["rows"]), min(r["omega_pi"] for r in _study("long2000")["rows"]))))),
+    (PAPER, lambda: "The 17 rad/s motion of B (λ₁ ≈ {:.3f} s⁻¹, {})".format(
+        _row("headings_eps1e-4", "rest psi0=157.5deg", 17.0)["lyapunov"], _row("headings_eps1e-4", "rest psi0=157.5deg", 17.0)["allowed"])),
+    (PAPER, lambda: "| 14 | not periodic ({} in study B, λ₁ ≈ {:.1f} s⁻¹), bounded |".format(
+        _row("headings_eps1e-4", "rest psi0=157.5deg", 14.0)["allowed"], _row("headings_eps1e-4", "rest psi0=157.5deg", 14.0)["lyapunov"])),
+    (PAPER, lambda: "a threshold of {:.3f} s⁻¹ on the point estimate".format(
+        _json("docs/paper-reproduction/figures_psi157.5.json")["chaos_threshold"])),
+]
+
 # inputs, not results: the labelling rule's thresholds and the period detector's tolerance
 SETTINGS = [
     (MAP, "λ₁ − 2 s.e. > 0.02 s⁻¹"),
@@ -153,4 +206,5 @@ SETTINGS = [
     (LABELS, "the interval λ₁ ± 2 s.e. reaches across +0.02 or −0.02 s⁻¹"),
     (LABELS, "within 1e-4 × (1 + max |x|) of sample"),
     (LABELS, "**0.02 s⁻¹** — the threshold"),
+    (PAPER, "from λ₁ ± 2 standard errors against 0.02 s⁻¹"),
 ]
