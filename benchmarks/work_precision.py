@@ -292,7 +292,9 @@ def main(argv=None):
         res = dict(scenes=[], float32=[], laws=[], done=[], references={})
     res["config"] = {k: v for k, v in cfg.items()}
     if not args.plot_only:
-        res.setdefault("sessions", []).append(
+        if "sessions" in res:  # files written before the key was named "runs"
+            res["runs"] = res.pop("sessions")
+        res.setdefault("runs", []).append(
             dict(versions=info, started=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()))
         )
     res["versions"] = info

@@ -11,7 +11,6 @@ library (`jaxcelt.bifurcation`, `jaxcelt.sweeps.dense.dense_trajectory`, `jaxcel
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from pathlib import Path
 
@@ -23,6 +22,7 @@ import numpy as np  # noqa: E402
 import jaxcelt as jc  # noqa: E402
 from jaxcelt.ensemble import SweepConfig  # noqa: E402
 from jaxcelt.plotting.bifurcation import bifurcation_figure, orbit_figure  # noqa: E402
+from jaxcelt.provenance import write_result  # noqa: E402
 from jaxcelt.sweeps.dataset import to_dataset  # noqa: E402
 from jaxcelt.sweeps.dense import dense_trajectory  # noqa: E402
 from jaxcelt.sweeps.regimes import GLOBAL_MOTION, classify, regime_names  # noqa: E402
@@ -94,7 +94,7 @@ def main(argv=None):
         fig.savefig(out / f"fig4-7_{tag}_w{w:g}.png", dpi=100)
         print(w, label, flush=True)
     info["wall_s"] = time.perf_counter() - t
-    (out / f"figures_{tag}.json").write_text(json.dumps(info, indent=1, default=str))
+    write_result(out / f"figures_{tag}.json", info, default=str)
 
 
 if __name__ == "__main__":

@@ -133,7 +133,11 @@ def relabel_file(path: Path) -> dict:
     d["labelling_rule"] = RULE + (
         "" if all("lyapunov_stderr" in r for r in d["rows"]) else " (no standard error stored: the point estimate decides)"
     )
-    path.write_text(json.dumps(d, indent=1, default=str))
+    # the rows were integrated earlier: keep that run's provenance beside the re-labelling's
+    measured = d.pop("provenance", None)
+    if measured is not None:
+        d["provenance_of_integration"] = measured
+    write_result(path, d, default=str)
     return d
 
 
