@@ -362,6 +362,7 @@ QUOTES = [
 # numbers that are inputs (a record's length and rate, a noise level applied, a budget, a confidence level)
 SETTINGS = [
     (D, "95% interval θ ± 1.96 se"),
+    (D, "noise 0 and 1 % of each channel's RMS"),  # the noise levels bench_fit.py applies to problem 4p
     (D, "a sane 1 s record"),
     (D, "100 Hz, 1 s each"),
     (D, "m_Ts 35–50 % off the paper's values"),

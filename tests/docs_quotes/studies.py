@@ -614,3 +614,142 @@ SETTINGS += [
     (ST, "(the 2.5 s scene)"),
     (ST, "by its 300 s budget"),
 ]
+
+
+# ---- the work–precision tables of docs/internals/studies.md §2 (benchmarks/work_precision.py --report) ----
+
+
+def _wp_best(scene: str, target: float, key: str, explicit_only: bool = False) -> list[dict]:
+    """Per solver the successful run reaching ``target`` with the least ``key``; the solvers ordered by it."""
+    ok = [
+        r
+        for r in _wp_runs(scene)
+        if r["status"] == 0
+        and r.get("error") is not None
+        and r["error"] <= target
+        and r.get(key) is not None
+        and not (explicit_only and r["kind"] == "implicit")
+    ]
+    best = {s: min((r for r in ok if r["solver"] == s), key=lambda r: r[key]) for s in {r["solver"] for r in ok}}
+    return sorted(best.values(), key=lambda r: r[key])
+
+
+def _wp_label(r: dict) -> str:
+    how = f"rtol {r['rtol']:.0e}" if r.get("rtol") is not None else f"dt {r['dt0']:g} s"
+    return f"{r['solver']} {how}"
+
+
+def _wp_table_row(scene: str, target: float) -> str:
+    """One row of a scene's 'cheapest run reaching each target error' table."""
+    fast = _wp_best(scene, target, "run_s")
+    fewest = _wp_best(scene, target, "rhs_evals", explicit_only=True)[0]
+    cell = lambda r: f"{_wp_label(r)}: {1e3 * r['run_s']:.0f} ms, err {r['error']:.1e}"  # noqa: E731
+    return f"| {target:.0e} | {cell(fast[0])} | {cell(fast[1])} | {_wp_label(fewest)}: {_sp(fewest['rhs_evals'])} |"
+
+
+QUOTES += [
+    (ST, lambda s=s, t=t: _wp_table_row(s, t))
+    for s in ("rest14", "rest17", "rest19", "spin_reversal", "spin_reversal_long", "stick_slip")
+    for t in (1e-4, 1e-6, 1e-8, 1e-10)
+]
+
+
+def _laws_ref_text() -> str:
+    """The integral law's reference run and its first (compiling) run per solver."""
+    L = next(x for x in _perf("work_precision.json")["laws"] if x["law"] == "integral")
+    c = [max(r["compile_s"] for r in L["runs"] if r["solver"] == s and "run_s" in r) for s in ("Tsit5", "Dopri8")]
+    ref = _perf("work_precision.json")["references"]["rest17/5/integral"]
+    return f"(reference {_sp(ref['steps'])} steps, compile {min(c):.0f}–{max(c):.0f} s per solver)"
+
+
+def _rejected_text() -> str:
+    x = [
+        100 * r["rejected"] / (r["accepted"] + r["rejected"])
+        for s in _SLIDING
+        for r in _wp_runs(s)
+        if r["kind"] == "explicit"
+    ]
+    return f"{min(x):.0f}–{max(x):.0f} % of explicit steps are rejected on the non-stiff scenes"
+
+
+def _stab_ref(eps: float, tag: str = "a") -> dict:
+    return next(
+        r
+        for r in _perf(f"stability_{tag}.json")["rows"]
+        if r.get("kind") == "reference" and r["method"].startswith("Dopri8") and r["eps"] == eps
+    )
+
+
+def _stick_wrong_text() -> str:
+    e = [
+        r["error_vs_ref"]
+        for r in _perf("stability_b.json")["rows"]
+        if r.get("kind") == "cell" and r["scene"].startswith("stick-slip") and r["dt"] >= 2e-4
+    ]
+    return f"(stick–slip: errors {min(e):.1e} … {max(e):.2g} for dt ≥ 2e-4 s)".replace("e-0", "e-")
+
+
+def _f32_invalid_text() -> str:
+    import math
+
+    r = next(r for r in _perf("stability_c.json")["rows"] if r["omega_pi"] == 19 and r["run"] == "f32")
+    lo = _perf("stability_c.json")["rows"]
+    t = [x["first_invalid_t"] for x in lo if x["omega_pi"] == 19] + [r["first_invalid_t_f64"]]
+    per = (min(t) + max(t)) / 2 * 19 / (2 * math.pi)
+    return f"at {min(t):.1f}–{max(t):.1f} s (≈ {per:.0f} periods)"
+
+
+def _tip_text() -> str:
+    rows = [r for r in _perf("stability_e.json")["rows"] if r.get("case", "").startswith("tilt towards") and r["x"] >= 85]
+    t = ", ".join(f"{r['first_invalid_t']:.2g}" for r in rows)
+    n = [r["steps"] for r in rows]
+    return f'half-surface (n3 ≤ 0)" at t = {t} s, the solve itself reports success ({min(n)}–{max(n)} steps)'
+
+
+def _k5n8_eps10_text() -> str:
+    import re
+
+    why = _stab("Kvaerno5-Newton rtol 1e-08", 1e-10)["why"]
+    pred = re.search(r"predicted (\d+) s", why).group(1)
+    return f"1e-8, ε = 1e-10 was not run (predicted {pred} s)"
+
+
+QUOTES += [
+    (
+        ST,
+        lambda: (
+            lambda r: f"1e-8 took {_sp(round(r['steps'], -2))} steps and {r['run_s']:.0f} s on rest17"
+        )(_wp_run("rest17", "Kvaerno3-Newton", 1e-8)),
+    ),
+    (
+        ST,
+        lambda: (
+            lambda t: f"Kvaerno5-Newton at rtol 1e-4 takes {min(t):.1f}–{max(t):.1f} s on rest17/rest19"
+        )([_wp_run(s, "Kvaerno5-Newton", 1e-4)["run_s"] for s in ("rest17", "rest19")]),
+    ),
+    (ST, _laws_ref_text),
+    (ST, _rejected_text),
+    (
+        ST,
+        lambda: (
+            f"at ε = 1e-8 it took {_sp(_stab_ref(1e-8)['steps'])} steps; at ε = 1e-10 it needs "
+            f"{_sp(_stab_ref(1e-10, 'a_eps1e-10')['steps'])} steps ({_stab_ref(1e-10, 'a_eps1e-10')['run_s']:.0f} s)"
+        ),
+    ),
+    (
+        ST,
+        lambda: (
+            lambda a, b: f"it is ok to ε = 1e-6 ({_sp(a['steps'])} steps) but needs {_sp(b['steps'])} steps "
+            f"({100 * b['rejected'] / b['steps']:.0f} % rejected) at ε = 1e-8"
+        )(_stab("Kvaerno5-Newton rtol 1e-08", 1e-6), _stab("Kvaerno5-Newton rtol 1e-08", 1e-8)),
+    ),
+    (ST, _stick_wrong_text),
+    (ST, _f32_invalid_text),
+    (ST, _tip_text),
+    (ST, _k5n8_eps10_text),
+]
+
+SETTINGS += [
+    # the no-slip energy test's tolerance and horizon (tests/test_noslip.py::test_energy_conserved_10s)
+    (CL, "(test: ≤ 1e-10 over 10 s)"),
+]
