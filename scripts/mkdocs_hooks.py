@@ -24,9 +24,22 @@ _LINK = re.compile(r"(!?\[[^\]]*\]\()([^)\s#]+)(#[^)\s]*)?(\))")
 def on_files(files, config):
     for uri, src in OUTSIDE_PAGES.items():
         files.append(File.generated(config, uri, abs_src_path=str(ROOT / src)))
+    files.append(File.generated(config, "results.md", content=_results_page()))
     for nb in sorted((ROOT / "notebooks").glob("*.ipynb")):
         files.append(File(f"notebooks/{nb.name}", str(ROOT), config["site_dir"], config["use_directory_urls"]))
     return files
+
+
+def _results_page() -> str:
+    """The results index (scripts/results_index.py), made for this build."""
+    import importlib.util
+    import sys
+
+    spec = importlib.util.spec_from_file_location("results_index", ROOT / "scripts" / "results_index.py")
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = mod
+    spec.loader.exec_module(mod)
+    return mod.page()
 
 
 def on_page_markdown(markdown, page, config, files):
