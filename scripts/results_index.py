@@ -8,17 +8,20 @@
 The site's "Results index" page is this script's page, made when the site is built (``scripts/mkdocs_hooks.py``),
 so it always describes the files and the code of the build.
 
-A *quoted number* is a measured quantity in the prose of a site page, the README or a notebook's text: a time
-(``12.3 s``, ``450 ms``, ``2 min``), a ratio (``2.12×``), a percentage (``17.7 %``) or a step count in millions
-(``35.2 M``). Each one must be either
+A *quoted number* is a number in the prose of a site page, the README or a notebook's text that is either a measured
+quantity — a time (``12.3 s``, ``450 ms``, ``2 min``), a ratio (``2.12×``), a percentage (``17.7 %``), a step count
+in millions (``35.2 M``) — or any number written with a decimal point or an exponent (a fraction, an exponent, an
+error, a located parameter value). Each one must be either
 
 * **verified**: it lies inside a text that ``tests/test_docs_numbers.py`` recomputes from a committed result file
   (the ``QUOTES`` registry in ``tests/docs_quotes``: document, text computed from the file); the index records which files each such text reads,
   the command that wrote each file (its ``provenance`` block, else the script that writes that file) and whether
   the file is older than the code it describes; or
 * **a setting**: an input rather than a result (``t = 300 s``, ``a threshold of 0.02 s⁻¹``, ``1 s gyro records``),
-  recognised by the words just before it (``INPUT_CONTEXT``) or lying inside a phrase of the registry's
-  ``SETTINGS`` list (document, phrase: each phrase must occur in its document).
+  recognised by the words just before it (``INPUT_CONTEXT``), by being a power of ten (a tolerance), a version or
+  section number, or one of the paper's parameter values (``PAPER_VALUES``), or lying inside a phrase of the
+  registry's ``SETTINGS`` list (document, phrase: each phrase must occur in its document). The model specification
+  (``SPECIFICATION_PAGES``) quotes the paper's equations and parameters, not results.
 
 Everything else is *unverified*, and ``--check`` (run by the test suite) fails on it. The changelog is not scanned:
 its entries keep the numbers of their time.
@@ -44,6 +47,26 @@ NUMBER = re.compile(
     r"(?<![\w.])(\d+(?:[.,]\d+)*)(?:\s?[–-]\s?\d+(?:\.\d+)?)?"  # 12.3, 1,124, 14–17
     r"(?:\s?(?:s|ms|min|h)\b(?!-)|\s?×(?!\s?\d)|\s?%|\s?M\b(?= (?:steps|lane-steps|lanes? ?steps)))"
 )
+# any other number written with a decimal point or an exponent (a fraction, an exponent, a multiplier, an error)
+DECIMAL = re.compile(r"(?<![\w.\-−/])[−-]?(?:\d+\.\d+(?:\s?[eE][−-]?\d+)?|\d+[eE][−-]?\d+)(?![\w.]*\d)(?!\.\d)")
+# powers of ten are tolerances, thresholds and smoothing constants (settings); so are version numbers and the
+# numbers of sections, equations and figures
+_SETTING_NUMBER = re.compile(r"^[−-]?1(?:\.0+)?(?:\s?[eE][−-]?\d+)$")
+_LABEL_CONTEXT = re.compile(
+    r"(?:jax|jaxlib|python|diffrax|equinox|optimistix|optax|numba|numpy|scipy|cuda|mkdocs|version|v|§|section|"
+    r"sections|eq\.|eqs\.|equation|fig\.|figs\.|figure|table|step|A\d+|ε\s?=\s?ε_R\s?=)\s*$",
+    re.IGNORECASE,
+)
+# pages that quote no results: the model specification gives the paper's equations and parameters
+SPECIFICATION_PAGES = {"docs/MODEL.md"}
+# the paper's parameter values (CeltParams.paper()) and forcing frequencies: inputs wherever they appear
+PAPER_VALUES = {
+    "0.11", "0.025", "0.5436", "0.0002463", "0.0013589", "0.0013747", "0.0001728", "−0.00429", "-0.00429", "9.81",
+    "0.006192", "0.1813", "0.2241", "0.4345", "1.196", "0.1498", "0.1121", "0.0589", "0.5305", "0.2476", "0.8161",
+    "0.5366", "0.04", "15.6", "17.0",
+}
+
+
 # words before a number that make it a setting, not a result (checked on the 40 characters before it)
 INPUT_CONTEXT = re.compile(
     r"(?:\bt|\bt_end|\bT|\bdt|horizon|transient|--[\w-]+|timeout|time limit|at most|threshold|tolerance|noise|"
@@ -137,18 +160,41 @@ def scan(quotes: list[Quote], settings: list[Quote]) -> dict[str, dict]:
         covered = _spans(text, by_doc.get(rel, []))  # spans of verified quote texts, in the prose
         declared = _spans(text, set_by_doc.get(rel, []))  # spans of declared settings
         rec = {"verified": [], "input": [], "unverified": [], "quotes": len(by_doc.get(rel, [])), "quotes_found": n_quotes_found}
-        for m in NUMBER.finditer(text):
+        for m in _numbers(text):
             ctx = text[max(0, m.start() - 60) : m.end() + 30]
+            before = text[max(0, m.start() - 40) : m.start()]
             if any(a <= m.start() and m.end() <= b for a, b in covered):
                 rec["verified"].append(m.group(0))
-            elif any(a <= m.start() and m.end() <= b for a, b in declared) or INPUT_CONTEXT.search(
-                text[max(0, m.start() - 40) : m.start()]
+            elif (
+                rel in SPECIFICATION_PAGES
+                or any(a <= m.start() and m.end() <= b for a, b in declared)
+                or INPUT_CONTEXT.search(before)
+                or _is_setting_number(m.group(0), before)
             ):
                 rec["input"].append(m.group(0))
             else:
                 rec["unverified"].append(ctx)
         out[rel] = rec
     return out
+
+
+def _numbers(text: str) -> list[re.Match]:
+    """Measured quantities (NUMBER) and the other decimal numbers (DECIMAL) not inside one, in order."""
+    found = list(NUMBER.finditer(text))
+    spans = [(m.start(), m.end()) for m in found]
+    for m in DECIMAL.finditer(text):
+        if not any(a <= m.start() < b for a, b in spans):
+            found.append(m)
+    return sorted(found, key=lambda m: m.start())
+
+
+def _is_setting_number(number: str, before: str) -> bool:
+    """A power of ten, a version or section number, or one of the paper's parameter values."""
+    return bool(
+        _SETTING_NUMBER.match(number.strip())
+        or number.strip() in PAPER_VALUES
+        or _LABEL_CONTEXT.search(before)
+    )
 
 
 def _prose_of(s: str) -> str:
