@@ -746,9 +746,61 @@ QUOTES = [
             _bench()["numba_dp5_ensemble"]["total_steps"] / 1e6, _bench()["numba_dp5_ensemble"]["status_counts"]["3"]
         ),
     ),
+    # ---------------------------------------------------------------- docs/performance.md: the sweep table's other rows
+    (
+        PERF,
+        lambda: "| 2 threads | {:.1f} | not recorded (numba caches its compiled loop on disk) | {:.1e} |".format(
+            _bench()["numba_dp5_ensemble_stop_on_invalid"]["seconds"],
+            _bench()["accuracy_max_abs_err_5_periods_vs_dop853_1e-12"]["numba_dp5"],
+        ),
+    ),
+    (
+        PERF,
+        lambda: "| 1 | {:.1f} | — | {:.1e} |".format(
+            _bench()["scipy_dop853_numba_rhs_stop_on_invalid"]["seconds"],
+            _bench()["accuracy_max_abs_err_5_periods_vs_dop853_1e-12"]["scipy_dop853"],
+        ),
+    ),
+    # the fixed-step stability limit 2.785/rho (RK4) in the stick-slip scene at eps = 1e-4, scaled by sqrt(eps)
+    (
+        PERF,
+        lambda: "only with dt below the sticking limit ≈ {}·√ε s (RK4)".format(
+            "{:.1e}".format(
+                next(
+                    r for r in _json("docs/performance/stability_b.json")["rows"] if r.get("scene") == "stick-slip eps 1e-4"
+                )["dt_limit_RK4"]
+                / 1e-4**0.5
+            ).replace("e-0", "e-")
+        ),
+    ),
+    # ---------------------------------------------------------------- docs/internals/sweep-engine.md: more
+    (
+        ENGINE,
+        lambda: "1-minute load average {:.1f} at the start, `load_average_at_start`".format(_bench()["load_average_at_start"][0]),
+    ),
+    (
+        ENGINE,
+        lambda: "The grid's lanes take {} steps on average (median {}), so the full map is {:.2f} × 10¹⁰ lane-steps".format(
+            _sp(_census()["steps_mean"]),
+            _sp(_census()["steps_quantiles"]["q50"]),
+            _census()["projection"]["lane_steps"] / 1e10,
+        ),
+    ),
 ]
 
 SETTINGS = [
+    # inputs: the README's example start, the controller's constants, the map's box, a threshold, a constant,
+    # the supported versions, the reference's DOI
+    ("README.md", "at rest at heading ψ0 = 157.5° (long axis turned 22.5° from the vibration"),
+    (MAXSTEPS, "I-control, safety 0.9, step factor in [0.2, 10]"),
+    (MAXSTEPS, "at ω_π = 10.8271 both Tsitouras 5(4) integrators"),
+    (MAXSTEPS, "at 10.7268 jaxcelt's Tsit5"),
+    (ENGINE, "(Hairer's 0.4/0.3 and others)"),
+    (ENGINE, "q_π 0.02–0.06 m"),
+    ("docs/how-to/regime-labels.md", "O drifts more than 0.05 m over the samples"),
+    ("docs/explanation/lane-engine.md", "(`PILOT_FRACTION` = 0.1)"),
+    ("docs/install.md", "| 3.11 | 0.10 | | ≥ 3.12 | 0.11 – 0.12 |"),
+    ("docs/citing.md", "doi:10.5890/DNC.2014.06.002"),
     # targets the engine is measured against, and the census' definition of a sticking lane (stiff_factor)
     (ENGINE, "Per-RHS-evaluation cost within 1.5× of the numba ensemble"),
     (ENGINE, "(target 2×: **met**)"),
