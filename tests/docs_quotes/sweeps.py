@@ -166,6 +166,84 @@ def _max_steps_lane(omega: float) -> dict:
     return next(x for x in _json("docs/bifurcation/max_steps_study.json")["lanes"] if abs(x["omega_pi"] - omega) < 5e-5)
 
 
+# --- the full-size diagram's regimes (summary_400x300.json: runs of equal labels) and the float32 check ------------
+
+
+def _full_runs() -> list[dict]:
+    return _json("docs/bifurcation/summary_400x300.json")["regimes"]
+
+
+def _invalid_bands() -> list[tuple[float, float]]:
+    """The invalid stretches of the 400 x 300 diagram (runs of at least 10 invalid lanes)."""
+    return [(r["from"], r["to"]) for r in _full_runs() if r["label"].startswith("invalid") and r["n"] >= 10]
+
+
+def _long_valid_run() -> dict:
+    return max((r for r in _full_runs() if not r["label"].startswith("invalid")), key=lambda r: r["n"])
+
+
+def _full_bands_sentences() -> list[str]:
+    b = _invalid_bands()
+    f = "{:.1f}".format
+    band = [f"{f(lo)}–{f(hi)}" for lo, hi in b]
+    between = [r for r in _full_runs() if b[2][1] < r["from"] and r["to"] < b[3][0]]  # valid lanes between the last two
+    long = _long_valid_run()
+    return [
+        f"**{band[0]} rad/s, {', '.join(band[1:-1])} and {band[-1]}: invalid**",
+        f"**{f(b[0][1])}–{f(b[1][0])} rad/s: aperiodic with periodic windows**, among them a period-doubling structure: {_full_windows()}",
+        f"**{f(b[1][1])}–{f(long['from'])} rad/s: aperiodic, bounded and unbounded lanes interleaved**",
+        f"**{f(long['from'])}–{f(long['to'])}: a narrow band of ω₂**",
+        f"**{f(between[0]['from'])}–{f(between[-1]['to'])}: a few valid lanes",
+    ]
+
+
+def _full_windows() -> str:
+    """The periodic windows of the 400 x 300 diagram, adjacent lanes of one period merged, grouped by period."""
+    step = 10 / (_json("docs/bifurcation/summary_400x300.json")["n_values"] - 1)
+    wins: list[list] = []
+    for r in _full_runs():
+        k = r["label"].split(",")[0]
+        if not k.startswith("period-"):
+            continue
+        if wins and wins[-1][0] == k and r["from"] - wins[-1][2] < 1.5 * step:
+            wins[-1][2] = r["to"]
+        else:
+            wins.append([k, r["from"], r["to"]])
+    groups: dict[str, list[str]] = {}
+    for k, lo, hi in wins:
+        groups.setdefault(k, []).append(f"{lo:.2f}" if lo == hi else f"{lo:.2f}–{hi:.2f}")
+    items = list(groups.items())
+    head = [f"{k} at {' and '.join(w)}" for k, w in items[:-1]]
+    k, w = items[-1]
+    return ", ".join(head) + f", and a {k} window at {' and '.join(w)}"
+
+
+def _e(x: float) -> str:
+    """1.5e-9 as the docs write it (no leading zero in the exponent)."""
+    m, e = f"{x:.1e}".split("e")
+    return f"{m}e{int(e)}"
+
+
+def _float32_check_sentence() -> str:
+    cells = _json("docs/performance/float32_periodic_check.json")["cells"]
+
+    def span(key: str) -> str:
+        g = [c[key]["gap_at_float64_period"] for c in cells]
+        return f"{_e(min(g))}–{_e(max(g))}"
+
+    def regime(key: str) -> str:
+        (r,) = {c[key]["regime"] for c in cells}
+        return r
+
+    assert regime("float64_rtol1e-8") == regime("float64_rtol1e-6") == "periodic"
+    return (
+        f"{len(cells)} such cells run again on a CPU (`scripts/float32_periodic_check.py` → "
+        f"`docs/performance/float32_periodic_check.json`) repeat at the float64 period to {span('float64_rtol1e-8')} in "
+        f"float64 at rtol 1e-8 and to {span('float64_rtol1e-6')} at rtol 1e-6 (periodic both times: the test's tolerance "
+        f"is 1e-4), but in float32 at rtol 1e-6 only to {span('float32_rtol1e-6')} ({regime('float32_rtol1e-6')})"
+    )
+
+
 QUOTES = [
     # ---------------------------------------------------------------- docs/performance.md
     (PERF, lambda: _peers_sentence()),
@@ -786,6 +864,9 @@ QUOTES = [
             _census()["projection"]["lane_steps"] / 1e10,
         ),
     ),
+    # ---------------------------------------------------------------- docs/bifurcation/README.md: more
+    *[(BIF, lambda i=i: _full_bands_sentences()[i]) for i in range(5)],
+    (BIF, lambda: _float32_check_sentence()),
 ]
 
 SETTINGS = [
@@ -807,4 +888,8 @@ SETTINGS = [
     (ENGINE, "more than 10× the median steps"),
     # the tolerances the tests assert (tests/test_kernel.py, tests/test_lyapunov.py)
     (BIF, "step counts within 1 % (equal in the test's 16 lanes)"),
+    # the GPU map's box and periods, the kernel-against-pool check's grid, and the literature's Lorenz exponent
+    (BIF, "q_π 0.02–0.06 m, 270 + 30 periods"),
+    (BIF, "8 × 8 lanes of ω_π 15–20, q_π 0.04–0.06 over 10 periods"),
+    (BIF, "Lorenz against its published λ₁ = 0.9056"),
 ]
