@@ -208,3 +208,61 @@ SETTINGS = [
     (LABELS, "**0.02 s⁻¹** — the threshold"),
     (PAPER, "from λ₁ ± 2 standard errors against 0.02 s⁻¹"),
 ]
+
+
+# ---- docs/map/README.md: the map's load, the window check's lanes, the diagram's band it meets
+
+
+def _wc_box(group: str) -> str:
+    lanes = [_wc()["lanes"][i] for i in _wc_lanes(group)]
+    w = [x["omega_pi"] for x in lanes]
+    q = [x["q_pi"] for x in lanes]
+    return f"ω_π {min(w):g}–{max(w):g} rad/s, q_π {min(q):.3f}–{max(q):.3f} m"
+
+
+def _diagram_band() -> dict:
+    """The 400 x 300 diagram's longest run of valid lanes (summary_400x300.json)."""
+    runs = _json("docs/bifurcation/summary_400x300.json")["regimes"]
+    return max((r for r in runs if not r["label"].startswith("invalid")), key=lambda r: r["n"])
+
+
+QUOTES += [
+    (MAP, lambda: "(load average {:.2f} at the start, {:.1f} at the end; both in the JSON)".format(
+        _map()["load_average_before_after"][0][0], _map()["load_average_before_after"][1][0])),
+    (MAP, lambda: "runs {} lanes of the lower left ({}) and {} of the band at {}".format(
+        len(_wc_lanes("low")), _wc_box("low"), len(_wc_lanes("chaotic")), _wc_box("chaotic").replace("ω_π ", ""))),
+    (MAP, lambda: "at q_π = 0.04 m this is the band the bifurcation diagram shows at {:.1f}–{:.1f} rad/s".format(
+        _diagram_band()["from"], _diagram_band()["to"])),
+]
+
+# the map's grid (its command line)
+SETTINGS += [
+    (MAP, "--y q_pi=0.02:0.06:60"),
+    (MAP, "60 amplitudes 0.02–0.06 m"),
+]
+
+
+def _stable_omega2(w: str) -> float:
+    return next(o for o in _orb("branches")["paper_frequencies"][w] if o["stable"])["omega2"]
+
+
+def _b_drift() -> str:
+    """The period-1 lanes of study B at 15.6 rad/s: net drift of O below the quoted bound."""
+    drift = max(r["drift_m"] for r in _headings(15.6) if r["allowed"].startswith("period"))
+    if drift >= 1e-4:
+        raise AssertionError(f"drift {drift} m is not below 0.1 mm")
+    return "|Δr_O| < 0.1 mm over {} periods".format(_study("headings_eps1e-4")["config"]["sample"])
+
+
+QUOTES += [
+    (PAPER, lambda: "(the orbit of `branches.json` has ω₂ = {} rad/s on the section there)".format(
+        _m(_stable_omega2("15.6"), ".2f"))),
+    (PAPER, _b_drift),
+    ("notebooks/06_periodic_orbits.ipynb",
+     lambda: "loses stability in a Neimark–Sacker bifurcation near {:.1f} rad/s".format(_bifs()["Neimark-Sacker"]["value"])),
+]
+
+SETTINGS += [
+    ("notebooks/06_periodic_orbits.ipynb", "ψ0 = 157.5°"),
+    ("notebooks/02_bifurcation.ipynb", "from rest at ψ0 = 157.5°"),
+]
