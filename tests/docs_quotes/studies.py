@@ -753,3 +753,230 @@ SETTINGS += [
     # the no-slip energy test's tolerance and horizon (tests/test_noslip.py::test_energy_conserved_10s)
     (CL, "(test: ≤ 1e-10 over 10 s)"),
 ]
+
+
+# ---- docs/internals/studies.md §1–§3: reference table, conditions, float32, contact-law family, observations ----
+
+
+def _e(x: float, p: int = 1) -> str:
+    """A number in the page's short exponent form: 3.9e-5 (no leading zero in the exponent)."""
+    import re
+
+    return re.sub(r"e([+-])0*(\d)", lambda m: f"e{'-' if m.group(1) == '-' else ''}{m.group(2)}", f"{x:.{p}e}")
+
+
+def _ref_row(scene: str, periods: int) -> str:
+    """A row of §1's reference-agreement table (benchmarks/reference.py -> reference.json)."""
+    r = next(x for x in _perf("reference.json")["results"] if x["scene"] == scene and x["periods"] == periods)
+    p = r["params"]
+    if scene.startswith("rest"):
+        label = f"from rest, ω_π = {p['omega_pi']:g} | {periods} periods"
+    else:  # stick_slip: 'periods' counts samples, T/5 apart
+        label = (
+            f"stick–slip, q_π = {p['q_pi']:g} m, ε = ε_R = {_e(p['eps'], 0)} | {periods // 5} periods ({periods} samples)"
+        )
+    trusted = "all" if r["trusted_index"] == len(r["ts"]) - 1 else "not all"
+    return f"| {label} | {_e(r['max_agreement'])} | {trusted} | {_sp(r['A']['steps'])} | {_sp(r['B']['nfev'])} |"
+
+
+def _ref_growth_text() -> str:
+    x = [r["max_agreement"] for r in _perf("reference.json")["results"] if r["periods"] == 50]
+    import math
+
+    return f"(≈ 1e-13 → {math.floor(min(x) * 1e9)}–{math.ceil(max(x) * 1e9)}e-9 over 50 periods"
+
+
+def _all_wp_runs() -> list[dict]:
+    w = _perf("work_precision.json")
+    return [r for part in ("scenes", "float32", "laws") for g in w[part] for r in g["runs"] if "run_s" in r]
+
+
+def _f32(scene: str) -> list[dict]:
+    return next(f for f in _perf("work_precision.json")["float32"] if f["scene"] == scene)["runs"]
+
+
+def _f32_run(scene: str, solver: str, rtol: float) -> dict:
+    return next(r for r in _f32(scene) if r["solver"] == solver and r["rtol"] == rtol)
+
+
+def _f32_best(scene: str, solver: str) -> dict:
+    return min((r for r in _f32(scene) if r["solver"] == solver and r["status"] == 0), key=lambda r: r["error"])
+
+
+def _f32_floor_text() -> str:
+    b = {(s, v): _f32_best(s, v) for s in ("rest17", "stick_slip") for v in ("Dopri8", "Tsit5")}
+    floor = lambda s: _e(min(b[(s, "Dopri8")]["error"], b[(s, "Tsit5")]["error"]), 0)  # noqa: E731
+    cell = lambda s, v: f"{v} at {'rtol ' if (s, v) == ('rest17', 'Dopri8') else ''}{_e(b[(s, v)]['rtol'], 0)} ({_e(b[(s, v)]['error'])})"  # noqa: E731
+    return (
+        f"float32 floors at an error of ~{floor('rest17')} (rest17) and ~{floor('stick_slip')} (stick–slip)**: the best "
+        f"float32 runs are {cell('rest17', 'Dopri8')} and {cell('rest17', 'Tsit5')} on rest17, "
+        f"{cell('stick_slip', 'Dopri8')} and {cell('stick_slip', 'Tsit5')} on stick–slip"
+    )
+
+
+def _f32_match_text() -> str:
+    a, b = _f32_run("rest17", "Tsit5", 1e-5), _wp_run("rest17", "Tsit5", 1e-5)
+    c, d = _f32_run("stick_slip", "Tsit5", 1e-5), _wp_run("stick_slip", "Tsit5", 1e-5)
+    return (
+        f"(rest17, Tsit5 rtol 1e-5: {_e(a['error'], 2)} vs {_e(b['error'], 2)}; stick–slip, Tsit5 1e-5: "
+        f"{_e(c['error'])} vs {_e(d['error'])})"
+    )
+
+
+def _f32_budget_text() -> str:
+    r = _f32_run("rest17", "Dopri8", 1e-8)
+    assert r["status"] != 0 and _f32_run("stick_slip", "Dopri8", 1e-8)["status"] != 0
+    assert _f32_run("stick_slip", "Tsit5", 1e-8)["status"] != 0
+    return (
+        f"(rest17 Tsit5 1e-8: {_e(_f32_run('rest17', 'Tsit5', 1e-8)['error'])}) and rejected steps explode because "
+        f"round-off noise"
+    ), (
+        f"hit the {_sp(r['accepted'] + r['rejected'])}-step budget on both scenes (rest17: {_sp(r['accepted'])} accepted, "
+        f"{_sp(r['rejected'])} rejected; status {r['status']}, no result)"
+    )
+
+
+def _f32_table_row(scene: str, solver: str, dtype: str) -> str:
+    """A row of the float32-vs-float64 table as benchmarks/work_precision.py --report prints it."""
+    rtols = _perf("work_precision.json")["config"]["f32_rtols"]
+    rr = _f32(scene) if dtype == "float32" else _wp_runs(scene)
+    by = {r["rtol"]: r for r in rr if r["solver"] == solver and "run_s" in r}
+    cells = [
+        "" if t not in by else f"{by[t]['error']:.1e}" + ("" if by[t]["status"] == 0 else " (fail)") for t in rtols
+    ]
+    return " ".join((f"| {scene} | {solver} {dtype} | " + " | ".join(cells) + " |").split())  # the page collapses spaces
+
+
+def _laws_d8_text() -> str:
+    """Dopri8 and Tsit5 at rtol 1e-8 over the five laws: RHS evaluations (to hundreds) and errors."""
+
+    def span(solver):
+        rr = [_laws_run(L["law"], solver, 1e-8) for L in _perf("work_precision.json")["laws"]]
+        n = [round(r["rhs_evals"], -2) for r in rr]
+        e = [r["error"] for r in rr]
+        exp = int(f"{max(e):.1e}".split("e")[1])
+        return f"{_sp(min(n))}–{_sp(max(n))}", f"{min(e) / 10**exp:.1f}–{max(e) / 10**exp:.1f}e{exp}"
+
+    (nd, ed), (nt, et) = span("Dopri8"), span("Tsit5")
+    return f"(rtol 1e-8: Dopri8 {nd} evaluations for errors {ed}, Tsit5 {nt} for {et})"
+
+
+def _laws_table_row(law: str, r: dict) -> str:
+    return (
+        f"| {law} | {r['solver']} | {r['rtol']:.0e} | {r['error']:.2e} | {r['accepted']}+{r['rejected']} | "
+        f"{_sp(r['rhs_evals'])} | {1e3 * r['run_s']:.1f} | {r['compile_s']:.1f} |"
+    )
+
+
+def _laws_rows() -> list[tuple[str, dict]]:
+    return [(L["law"], r) for L in _perf("work_precision.json")["laws"] for r in L["runs"] if "run_s" in r]
+
+
+def _ratio_text() -> str:
+    """error/rtol of Tsit5 (and Dopri8) at rtol ≤ 1e-7 per scene, and of Tsit5 at rtol 1e-3 … 1e-5 on the from-rest scenes."""
+    import math
+
+    def q(scene, solver, lo, hi):
+        return [
+            r["error"] / r["rtol"] for r in _wp_runs(scene, solver) if r["status"] == 0 and lo <= r["rtol"] <= hi
+        ]
+
+    def span(scene, f1, f2):
+        x = q(scene, "Tsit5", 0, 1e-7)
+        return f"{min(x):{f1}}–{max(x):{f2}}"
+
+    d8 = max(x for s in _wp_scene_names() for x in q(s, "Dopri8", 0, 1e-7))
+    loose = [max(q(s, "Tsit5", 1e-5, 1e-3)) for s in ("rest14", "rest17", "rest19")]
+    dec = max(abs(math.log10(x)) for s in _wp_scene_names() for v in ("Tsit5", "Dopri8") for x in q(s, v, 0, 1e-7))
+    return (
+        f"Tsit5's error/rtol ratio (rtol ≤ 1e-7) is {span('rest17', '.0f', '.1f')} on rest17, {span('rest14', '.0f', '.1f')} "
+        f"on rest14, {span('rest19', '.1f', '.1f')} on rest19, {span('spin_reversal', '.1f', '.0f')} on the spin scene "
+        f"({span('spin_reversal_long', '.0f', '.0f')} through the reversal) and {span('stick_slip', '.1f', '.1f')} on "
+        f"stick–slip; Dopri8's is ≤ {d8:.1f} everywhere. At loose tolerances (1e-3 … 1e-5) the ratio reaches "
+        f"{min(loose):.0f}–{max(loose):.0f} on the from-rest scenes. A tolerance buys an error within ~{dec:.1f} decades"
+    )
+
+
+def _wp_scene_names() -> list[str]:
+    return [s["scene"] for s in _perf("work_precision.json")["scenes"]]
+
+
+def _fixed_text() -> str:
+    """RK4/Heun fixed-step errors: convergence on the short spin scene, the stall on rest17 and the long spin scene."""
+    import math
+
+    def ladder(scene, solver):
+        return sorted(_wp_runs(scene, solver), key=lambda r: -r["dt0"])
+
+    def order(rr):
+        return math.log(rr[0]["error"] / rr[-1]["error"]) / math.log(rr[0]["dt0"] / rr[-1]["dt0"])
+
+    rk, he = ladder("spin_reversal", "RK4-fixed"), ladder("spin_reversal", "Heun-fixed")
+    us = lambda r: f"{1e6 * r['dt0']:.0f} µs"  # noqa: E731
+    r17 = ladder("rest17", "RK4-fixed")[-3:]
+    lg = ladder("spin_reversal_long", "RK4-fixed")[-3:]
+    return (
+        f"RK4 converges ({_e(rk[0]['error'])} at dt = {1e3 * rk[0]['dt0']:g} ms → {_e(rk[-1]['error'])} at {us(rk[-1])}, "
+        f"measured order ≈ {order(rk):.1f}) and Heun at order {order(he):.1f} ({_e(he[0]['error'])} → {_e(he[-1]['error'])}). "
+        f"On the driven from-rest scenes both **stall at ~1e-4** (RK4 on rest17: {_e(r17[0]['error'])} at dt = {us(r17[0])}, "
+        f"{_e(r17[1]['error'])} at {us(r17[1])}, {_e(r17[2]['error'])} at {us(r17[2])}), and so does RK4 through the spin "
+        f"reversal (2.5 s: {_e(lg[0]['error'])} at {us(lg[0])}, {_e(lg[1]['error'])} at {us(lg[1])}, {_e(lg[2]['error'])} "
+        f"at {us(lg[2])})"
+    )
+
+
+def _stick_fixed_text() -> str:
+    e = [r["error"] for v in ("RK4-fixed", "Heun-fixed") for r in _wp_runs("stick_slip", v)]
+    return f"errors stay ≥ {_e(min(e))}"
+
+
+def _k5_same_error_text() -> str:
+    a, b = (_wp_run(s, "Kvaerno5-Newton", 1e-4)["error"] for s in ("rest17", "stick_slip"))
+    assert _e(a, 2) == _e(b, 2)
+    return f"Kvaerno5-Newton at rtol 1e-4 gives the same error, {_e(a, 2)}, on rest17 and stick–slip"
+
+
+QUOTES += [
+    (
+        ST,
+        lambda: (
+            f"re-run with a load average of {_perf('peers_idle.json')['versions']['loadavg_start'][0]:.1f} at the start"
+        ),
+    ),
+    *[(ST, lambda s=s, n=n: _ref_row(s, n)) for s in ("rest14", "rest17", "rest19") for n in (5, 50)],
+    (ST, lambda: _ref_row("stick_slip", 15)),
+    (ST, _ref_growth_text),
+    (
+        ST,
+        lambda: (
+            lambda la: f"the 1-min load average recorded with every run was **{min(la):.1f}–{max(la):.1f}** during this study"
+        )([r["loadavg_1min"] for r in _all_wp_runs()]),
+    ),
+    (ST, _f32_floor_text),
+    (ST, _f32_match_text),
+    (ST, lambda: _f32_budget_text()[0]),
+    (ST, lambda: _f32_budget_text()[1]),
+    *[
+        (ST, lambda s=s, v=v, t=t: _f32_table_row(s, v, t))
+        for s in ("rest17", "stick_slip")
+        for v in ("Tsit5", "Dopri8")
+        for t in ("float32", "float64")
+    ],
+    (ST, _laws_d8_text),
+    *[(ST, lambda i=i: _laws_table_row(*_laws_rows()[i])) for i in range(50)],
+    (ST, _ratio_text),
+    (ST, _fixed_text),
+    (ST, _stick_fixed_text),
+    (ST, _k5_same_error_text),
+]
+
+SETTINGS += [
+    # RK4's stability interval on the negative real axis (a constant of the method) over the friction relaxation
+    # rate 355/√ε computed just before it on the page
+    (ST, "dt ≲ 2.8/(3.6e4 s⁻¹)"),
+]
+
+QUOTES += [
+    # §2's stick–slip heading is the scene's description in work_precision.json
+    (ST, lambda: "### " + next(x for x in _perf("work_precision.json")["scenes"] if x["scene"] == "stick_slip")["description"]),
+]
