@@ -210,6 +210,281 @@ SETTINGS = [
 ]
 
 
+# ---- docs/orbits/README.md, whole rows and sentences (scripts/periodic_known_answers.py, orbit_check.py,
+# attractor_census.py, duffing_cascade.py, bifurcation_grad.py, orbit_branches.py, celt_fold_grad.py)
+
+
+def _e(x: float, digits: int = 1) -> str:
+    """An error as the orbits page prints it: 1.4e-13, 5.2e-9 (no leading zero in the exponent)."""
+    return format(x, f".{digits}e").replace("e-0", "e-").replace("e+0", "e+")
+
+
+def _ka() -> dict:
+    return _orb("known_answers")
+
+
+def _oc() -> dict:
+    return _orb("orbit_check")
+
+
+def _pairs(mu: list[float]) -> str:
+    """|μ| in decreasing order, equal neighbours (a complex pair) written once with '(pair)'."""
+    out, i = [], 0
+    while i < len(mu):
+        if i + 1 < len(mu) and abs(mu[i] - mu[i + 1]) < 1e-12:
+            out.append(f"{mu[i]:.4f} (pair)")
+            i += 2
+        else:
+            out.append(f"{mu[i]:.4f}")
+            i += 1
+    return ", ".join(out)
+
+
+def _census_row(w: str) -> str:
+    """A row of the census table, as scripts/attractor_census.py --table prints it."""
+    import math
+
+    r = _orb("census")["results"][w]
+    per = [
+        f"period-{a['k']}, {math.degrees(a['state'][12]) % 360:.1f}°, {a['fraction']:.3f}, {a['multipliers'][0]:.4f}"
+        for a in r["attractors"] if a["kind"] == "periodic"
+    ]
+    frac = {a["kind"]: a["fraction"] for a in r["attractors"] if a["kind"] != "periodic"}
+    return (f"| {w} | {r['n_lanes']} | {'; '.join(per) or 'none'} | {frac.get('aperiodic', 0.0):.3f} "
+            f"| {frac.get('invalid', 0.0):.3f} | {r['wall_s']:.0f} |")
+
+
+def _pd(i: int) -> dict:
+    return _orb("duffing_cascade")["period_doublings"][i]
+
+
+def _pd_periods(i: int) -> str:
+    (below,), (above,) = {*_pd(i)["brute_force_periods_below"]}, {*_pd(i)["brute_force_periods_above"]}
+    return f"{below} / {above}"
+
+
+def _bg() -> dict:
+    return _orb("bifurcation_grad")
+
+
+def _bifs() -> dict:
+    return {b["kind"]: b for b in next(iter(_orb("branches")["branches"].values()))["branch"]["bifurcations"]}
+
+
+def _paper_freq(w: str) -> list[float]:
+    """Largest |μ| of the family's orbits at a paper frequency: (stable, saddle)."""
+    orbits = _orb("branches")["paper_frequencies"][w]
+    stable = [o for o in orbits if o["multipliers_abs"][0] < 1.5]
+    saddle = [o for o in orbits if o["multipliers_abs"][0] >= 1.5]
+    return [stable[0]["multipliers_abs"][0], saddle[0]["multipliers_abs"][0]]
+
+
+def _ns_multiplier() -> complex:
+    re, im = max(_bifs()["Neimark-Sacker"]["multipliers"], key=lambda m: m[1])
+    return complex(re, im)
+
+
+def _cf() -> dict:
+    return _orb("celt_fold_grad")
+
+
+QUOTES += [
+    (ORBITS, lambda: "| analytic steady state / exp((−δ/2 ± iω_d)T) | {} / {} |".format(
+        _e(_ka()["linear"]["orbit_max_error"]), _e(_ka()["linear"]["multiplier_max_error"]))),
+    (ORBITS, lambda: "| Ince–Strutt series to q⁵ | b1: {} (first omitted term 49q⁶/589824: {}) |".format(
+        ", ".join(_e(x) for x in _ka()["mathieu"]["b1_minus_series"]),
+        ", ".join(_e(x) for x in _ka()["mathieu"]["first_omitted_term_49q6_over_589824"]))),
+    (ORBITS, lambda: "| scipy DOP853 after 80 periods / det M = exp(−δT) | {} / {} |".format(
+        _e(_ka()["duffing"]["orbit_max_error_vs_scipy"]), _e(_ka()["duffing"]["det_minus_exp_dT"]))),
+    (ORBITS, lambda: "give the Newton guess ({} from the orbit; one Newton step)".format(_e(_oc()["guess_distance"]))
+        if _oc()["newton_steps"] == 1 else "?"),
+    (ORBITS, lambda: f"| periodicity residual (chart coordinates) | {_e(_oc()['residual'])} |"),
+    (ORBITS, lambda: "| physical multipliers \\|μ\\| | {} |".format(_pairs(_oc()["multipliers_abs"]))),
+    (ORBITS, lambda: "| trivial multipliers | {} |".format(", ".join(
+        "1" if x == 1.0 else f"1 − {_e(1 - x, 0)}" for x in _oc()["trivial_multipliers_abs"]))),
+    (ORBITS, lambda: "| drift of C per period | {} m (bounded period-1) |".format(
+        _e(max(abs(d) for d in _oc()["drift_m"]), 0)) if _oc()["psi_turns"] == 0 else "?"),
+    (ORBITS, lambda: "(central differences, DOP853 rtol 1e-12) | {} |".format(_e(_oc()["multiplier_max_abs_diff_vs_scipy_fd"]))),
+    (ORBITS, lambda: "| defect of the orbit in the reference model | {} |".format(_e(_oc()["reference_fd_defect"]))),
+    *[(ORBITS, (lambda w=w: _census_row(w))) for w in ("14", "15.6", "17", "19")],
+    (ORBITS, lambda: "| 1 → 2 | {:.7f} | {} | {:.7f} ({} from F_PD; grid step 1e-4) |".format(
+        _pd(0)["F_pd"], _pd_periods(0), _pd(0)["brute_force_onset"], _e(_pd(0)["onset_difference"]))),
+    (ORBITS, lambda: "| 2 → 4 | {:.7f} | {} | {} from F_PD |".format(
+        _pd(1)["F_pd"], _pd_periods(1), _e(_pd(1)["onset_difference"]))),
+    (ORBITS, lambda: "| 4 → 8 | {:.7f} | {} | (window too narrow for the fit) |".format(
+        _pd(2)["F_pd"], _pd_periods(2)) if "brute_force_onset" not in _pd(2) else "?"),
+    (ORBITS, lambda: "F_PD = {:.7f} ({} Newton steps, residual {}, multipliers {} and {}), and dF_PD/dδ = {:.10f} by".format(
+        _bg()["F_pd"], _bg()["newton_steps"], _e(_bg()["residual"]),
+        _m(_bg()["multipliers"][0][0], ".11f"), _m(_bg()["multipliers"][1][0], ".4f"), _bg()["dF_pd_ddelta_grad"])),
+    (ORBITS, lambda: "{:.10f} by central differences of the located point (step 1e-4): relative difference {}.".format(
+        _bg()["dF_pd_ddelta_fd"], _e(_bg()["relative_difference"]))),
+    (ORBITS, lambda: "the family does not extend below its fold near {:.2f} rad/s.".format(_bifs()["fold"]["value"])),
+    (ORBITS, lambda: "interpolated between points {:.3f} apart | a real multiplier through +1 (the other sheet: a real "
+        "multiplier {:.4f} at 15.6 rad/s) |".format(
+            _bifs()["fold"]["bracket"][1] - _bifs()["fold"]["bracket"][0], _paper_freq("15.6")[1])),
+    (ORBITS, lambda: "| \\|μ\\| = 1 − {}, μ = {:.4f} ± {:.4f}i (rotation {:.3f} rad per period) |".format(
+        _e(1 - abs(_ns_multiplier()), 0), _ns_multiplier().real, _ns_multiplier().imag,
+        __import__("cmath").phase(_ns_multiplier()))),
+    (ORBITS, lambda: "saddle all the way to 20 rad/s, and past {:.4f} rad/s the orbit itself is unstable".format(
+        _bifs()["Neimark-Sacker"]["value"])),
+    (ORBITS, lambda: "The two branches of the mirror pair have the same bifurcations to {} in ω_π".format(
+        _e(_orb("branches")["mirror_check"]["max_bifurcation_value_difference"])) if _orb("branches")["mirror_check"]["same_kinds"] else "?"),
+    (ORBITS, lambda: "| 15.6 | stable; saddle | {:.4f}; {:.4f} |".format(*_paper_freq("15.6"))),
+    (ORBITS, lambda: "| 19 | unstable (past the Neimark–Sacker point); saddle | {:.4f}; {:.4f} |".format(*_paper_freq("19.0"))),
+    (ORBITS, lambda: "a disturbance shrinks by {:.4f} per period, by a factor e only after about {:.0f} periods".format(
+        _paper_freq("17.0")[0], round(-1 / __import__("math").log(_paper_freq("17.0")[0]), -1))),
+    (ORBITS, lambda: "the fold the continuation interpolated ({:.6f} rad/s): ω_fold = {:.6f} rad/s after {} Newton steps "
+        "(residual {}, largest multiplier 1 − {}, the next {:.4f}).".format(
+            _cf()["omega_fold_continuation"], _cf()["omega_fold"], _cf()["newton_steps"], _e(_cf()["residual"]),
+            _e(1 - _cf()["multipliers_abs"][0]), _cf()["multipliers_abs"][1])),
+    (ORBITS, lambda: "dω_fold/dμ = {} rad/s, against central differences of the located fold (step 1e-4): {}, relative "
+        "difference {}.".format(_m(_cf()["domega_fold_dmu_grad"], ".7f"), _m(_cf()["domega_fold_dmu_fd"], ".7f"),
+                                _e(_cf()["relative_difference"]))),
+]
+
+# the test problems' equations and the brute-force diagram's range are inputs; so is Feigenbaum's constant, which
+# scripts/duffing_cascade.py uses to size the window of the next doubling
+SETTINGS += [
+    (ORBITS, "linear oscillator x'' + 0.3x' + 2.25x = 0.7 cos 2.1t"),
+    (ORBITS, "Mathieu tongue edges b1(q), a1(q), q = 0.1, 0.2, 0.4"),
+    (ORBITS, "Duffing x'' + 0.25x' + x + 0.5x³ = 0.3 cos 1.3t"),
+    (ORBITS, "x'' + 0.3x' − x + x³ = F cos 1.2t is continued in F from 0.24"),
+    (ORBITS, "383 values of F in [0.255, 0.2932]"),
+    (ORBITS, "(Feigenbaum's limit 4.669)"),
+    (ORBITS, "x'' + δx' − x + x³ = F cos 1.2t, δ = 0.3"),
+    (ORBITS, "arclength steps 0.05–0.3"),
+    (ORBITS, "ψ0 = 157.5°"),
+]
+
+
+# ---- docs/paper-reproduction.md, whole rows and sentences (scripts/paper_study.py; the branch values from
+# scripts/orbit_branches.py)
+
+
+def _hd(ic: str) -> float:
+    """The start heading in degrees from a study row's initial condition ('rest psi0=22.5deg')."""
+    return float(ic.removeprefix("rest psi0=").removesuffix("deg"))
+
+
+def _deg(x: float) -> str:
+    return f"{x:g}°"
+
+
+def _tab(tag: str) -> list[dict]:
+    return _study(tag)["table"]
+
+
+def _cell(label: str, lam: bool = False) -> str:
+    """A table cell from the study's label 'chaotic, bounded, λ=0.284': with its λ₁ in brackets when asked."""
+    text, _, value = label.rpartition(", λ=")
+    return f"{text} (λ₁ {value})" if lam else text
+
+
+_W = ("14.0", "15.6", "17.0", "19.0")
+
+
+def _heading_row(t: dict) -> str:
+    return "| {} | {} | {} / {} |".format(
+        _deg(_hd(t["ic"])), " | ".join(_cell(t["labels"][w]) for w in _W), t["score_strict"], t["score_allowed"])
+
+
+def _heading_table_row(deg: float) -> str:
+    return _heading_row(next(t for t in _tab("headings_eps1e-4") if _hd(t["ic"]) == deg))
+
+
+def _eps_row(tag: str, eps: float, deg: float) -> str:
+    t = next(t for t in _tab(tag) if t["eps"] == eps and _hd(t["ic"]) == deg)
+    lam = deg == 157.5
+    return "| {:g} | {} | {} | {} / {} |".format(
+        eps, _deg(deg), " | ".join(_cell(t["labels"][w], lam) for w in _W), t["score_strict"], t["score_allowed"])
+
+
+def _b_set(omega: float, pred) -> set[float]:
+    """Headings of study B whose lane at omega satisfies pred(row)."""
+    return {_hd(r["ic"]) for r in _study("headings_eps1e-4")["rows"] if r["omega_pi"] == omega and pred(r)}
+
+
+def _and_mirror(lo: float, hi: float) -> set[float]:
+    """Headings lo..hi of the 22.5° grid and their images under +180°."""
+    grid = [22.5 * i for i in range(16)]
+    return {h for h in grid if lo <= h <= hi} | {h + 180 for h in grid if lo <= h <= hi}
+
+
+def _check(found: set[float], expected: set[float], text: str) -> str:
+    if found != expected:
+        raise AssertionError(f"study B gives {sorted(found)}, the text says {sorted(expected)}")
+    return text
+
+
+def _b_period1() -> str:
+    p1 = _b_set(15.6, lambda r: r["allowed"].startswith("period"))
+    lo, hi = min(p1), max(h for h in p1 if h < 180)
+    inv = sorted(h for h in p1 if h < 180 and h in _b_set(15.6, lambda r: r["strict"] == "invalid"))
+    return _check(p1, _and_mirror(lo, hi),
+                  "Headings ψ0 = {}–{} (and +180°) give a period-1 motion at 15.6 rad/s (at {} after leaving the model's "
+                  "validity)".format(_deg(lo), _deg(hi), " and ".join(_deg(h) for h in inv)))
+
+
+def _b_tip156() -> str:
+    tip = _b_set(15.6, lambda r: r["strict"] == "invalid" and not r["allowed"].startswith("period"))
+    lo, hi = min(h for h in tip if h % 180), max(h for h in tip if h < 180)
+    return _check(tip, {0.0, 180.0} | _and_mirror(lo, hi),
+                  "the headings along the vibration (ψ0 = 0°, 180°) and {}–{} (and +180°) tip past 90° at 15.6 rad/s".format(
+                      _deg(lo), _deg(hi)))
+
+
+def _b_near_zero17() -> str:
+    near = {_hd(r["ic"]) for r in _headings(17.0) if abs(r["lyapunov"]) < 0.01 and r["allowed"] == "uncertain"}
+    lo, hi = min(near), max(h for h in near if h < 180)
+    return _check(near, _and_mirror(lo, hi), "At 17 rad/s the headings {}–{} (and +180°) give an exponent within {:.2f} s⁻¹ "
+                  "of zero".format(_deg(lo), _deg(hi), _ceil2(max(abs(r["lyapunov"]) for r in _headings(17.0, near)))))
+
+
+def _b_valid19() -> str:
+    valid = _b_set(19.0, lambda r: r["strict"] != "invalid")
+    a = sorted(h for h in valid if h < 180)
+    kinds = {r["allowed"] for r in _headings(19.0) if r["strict"] != "invalid"}
+    bounded = {r["global_motion"] for r in _headings(19.0) if r["strict"] != "invalid"}
+    return _check(valid, _and_mirror(a[0], a[-1]), "except {}–{} and {}–{}, which stay valid with a {}, {} motion".format(
+        _deg(a[0]), _deg(a[-1]), _deg(a[0] + 180), _deg(a[-1] + 180), "/".join(sorted(bounded)), "/".join(sorted(kinds))))
+
+
+def _long_row() -> str:
+    t = next(t for t in _tab("long2000") if _hd(t["ic"]) == 157.5)
+    c = [_cell(t["labels"][w]) for w in _W]
+    lam14 = float(t["labels"]["14.0"].rpartition("λ=")[2])
+    first, rest = c[2].split(", ", 1)
+    return "| 157.5° | {} (λ₁ {:.2f}) | {} | **{}**, {} | {} |".format(c[0], lam14, c[1], first, rest, c[3])
+
+
+QUOTES += [
+    (PAPER, lambda: "is born in a fold at {:.2f} rad/s".format(_bifs()["fold"]["value"])),
+    (PAPER, lambda: "stable but weakly so there (largest multiplier {:.4f} per period), which loses stability in a "
+        "Neimark–Sacker bifurcation at {:.2f} rad/s".format(_paper_freq("17.0")[0], _bifs()["Neimark-Sacker"]["value"])),
+    *[(PAPER, (lambda d=22.5 * i: _heading_table_row(d))) for i in range(16)],
+    (PAPER, _b_period1),
+    (PAPER, _b_tip156),
+    (PAPER, _b_near_zero17),
+    (PAPER, _b_valid19),
+    (PAPER, _long_row),
+    *[(PAPER, (lambda a=a: _eps_row(*a))) for a in (
+        ("eps_large", 0.01, 157.5), ("eps_large", 0.01, 0.0), ("eps_large", 0.001, 157.5), ("eps_large", 0.001, 0.0),
+        ("headings_eps1e-4", 0.0001, 157.5), ("headings_eps1e-4", 0.0001, 0.0),
+        ("eps1e-6", 1e-06, 157.5), ("eps1e-6", 1e-06, 0.0), ("eps1e-8", 1e-08, 157.5), ("eps1e-8", 1e-08, 0.0))],
+]
+
+# the start headings and the sets of them each study ran are inputs
+SETTINGS += [
+    (PAPER, "ψ0 = 157.5°"),
+    (PAPER, "its long axis x1 turned 22.5° from the vibration direction"),
+    (PAPER, "16 headings ψ0 = 0°, 22.5°, …, 337.5°"),
+    (PAPER, "ψ0 ∈ {0°, 90°, 157.5°}"),
+    (PAPER, "ψ0 ∈ {0°, 135°, 157.5°}"),
+    (PAPER, "ψ0 ∈ {0°, 157.5°}"),
+    (PAPER, "each of their 157.5° scores"),
+]
+
+
 # ---- docs/map/README.md: the map's load, the window check's lanes, the diagram's band it meets
 
 
