@@ -83,7 +83,10 @@ def _b_scene(i: int) -> dict:
 
 
 def _b_largest_ok(scene: str, method: str) -> str:
-    c = max((r for r in _rows("b", "cell") if r["scene"] == scene and r["method"] == method and r["verdict"] == "ok"), key=lambda r: r["dt"])
+    c = max(
+        (r for r in _rows("b", "cell") if r["scene"] == scene and r["method"] == method and r["verdict"] == "ok"),
+        key=lambda r: r["dt"],
+    )
     return c["dt"], c["error_vs_ref"]
 
 
@@ -200,7 +203,11 @@ def _n_cont(x: float) -> str:
 
 
 def _lift(case: str, x: float, stop: bool) -> dict:
-    return next(r for r in _rows("e") if r.get("case", "").startswith(f"pitching at {case}") and r["x"] == x and r["stop_on_invalid"] == stop)
+    return next(
+        r
+        for r in _rows("e")
+        if r.get("case", "").startswith(f"pitching at {case}") and r["x"] == x and r["stop_on_invalid"] == stop
+    )
 
 
 def _lift_row(tilt: int, ws: tuple, label: str, t_label: str | None = None) -> str:
@@ -216,7 +223,13 @@ def _lift_row(tilt: int, ws: tuple, label: str, t_label: str | None = None) -> s
 
 
 def _lift_stop_text() -> str:
-    n = [r["min_N"] for r in _rows("e") if r.get("case", "").startswith("pitching") and r["stop_on_invalid"] and r["invalid_kind"].startswith("lift-off")]
+    n = [
+        r["min_N"]
+        for r in _rows("e")
+        if r.get("case", "").startswith("pitching")
+        and r["stop_on_invalid"]
+        and r["invalid_kind"].startswith("lift-off")
+    ]
     return _minus(f"N at the stop {max(n):.1g} … {min(n):.2g} N")
 
 
@@ -274,13 +287,11 @@ def _run(x: float) -> str:
 def _scal_row(lanes: int) -> str:
     j, n = _scal("jaxcelt", lanes), _scal("numba", lanes)
     r = j["run_s"] / n["run_s"]
+    ratio = f"{r:.2f}" if r < 2 else f"{r:.1f}"
     return (
         f"| {lanes} | {j['lanes_per_s']:.0f} | {_e(j['lane_steps_per_s'])} | {_run(j['run_s'])} | {j['compile_s']:.0f} | "
         f"{j['peak_rss_mb']:.0f} | {n['lanes_per_s']:.0f} | {_e(n['lane_steps_per_s'])} | {_run(n['run_s'])} | "
-        f"{n['peak_rss_mb']:.0f} | {r:.2f} |" if r < 2 else
-        f"| {lanes} | {j['lanes_per_s']:.0f} | {_e(j['lane_steps_per_s'])} | {_run(j['run_s'])} | {j['compile_s']:.0f} | "
-        f"{j['peak_rss_mb']:.0f} | {n['lanes_per_s']:.0f} | {_e(n['lane_steps_per_s'])} | {_run(n['run_s'])} | "
-        f"{n['peak_rss_mb']:.0f} | {r:.1f} |"
+        f"{n['peak_rss_mb']:.0f} | {ratio} |"
     )
 
 
@@ -354,11 +365,18 @@ QUOTES = [
     (ST, lambda: f"{_rk4_const():.3f}/ρ ≈ {_e(_rk4_const() / _rho_coeff())}·√ε s"),
     (
         ST,
-        lambda: f"ρ ≈ {round(_rho_coeff(), -1):.0f}/√ε 1/s: {_e(_b_scene(1)['spectral_radius'])} at ε = 1e-4, "
-        f"{_e(_b_scene(2)['spectral_radius'])} at ε = 1e-6",
+        lambda: (
+            f"ρ ≈ {round(_rho_coeff(), -1):.0f}/√ε 1/s: {_e(_b_scene(1)['spectral_radius'])} at ε = 1e-4, "
+            f"{_e(_b_scene(2)['spectral_radius'])} at ε = 1e-6"
+        ),
     ),
     (ST, _lam_text),
-    (ST, lambda: "**" + ", ".join(f"{r['exponent']:.3f} 1/s at ω_π = {r['omega_pi']}" for r in _rows("d", "lyapunov")) + "**"),
+    (
+        ST,
+        lambda: (
+            "**" + ", ".join(f"{r['exponent']:.3f} 1/s at ω_π = {r['omega_pi']}" for r in _rows("d", "lyapunov")) + "**"
+        ),
+    ),
     (ST, lambda: _grad_rows(17)),
     (ST, lambda: _grad_rows(19)),
     (ST, _mem_row),
@@ -368,9 +386,9 @@ QUOTES = [
     (ST, _memory_text),
     (
         ST,
-        lambda: (
-            lambda r: f"(|ψ| up to {r['max_abs_psi']:.1f} rad within"
-        )(next(r for r in _rows("e") if r.get("case", "").startswith("n2 -> 1") and r.get("x") == 1e-7)),
+        lambda: (lambda r: f"(|ψ| up to {r['max_abs_psi']:.1f} rad within")(
+            next(r for r in _rows("e") if r.get("case", "").startswith("n2 -> 1") and r.get("x") == 1e-7)
+        ),
     ),
     (ST, lambda: _lift_row(40, (10.0,), "n3 ≤ 0 (tips over)")),
     (ST, lambda: _lift_row(40, (11.0,), "lift-off (N ≤ 0)")),
@@ -383,8 +401,10 @@ QUOTES = [
     (ST, lambda: f"Tsit5 finishes with {_cell('a_eps1e-10', 'Tsit5 rtol 1e-06', 1e-10)['steps'] / 1e5:.1f}·10⁵ steps"),
     (
         ST,
-        lambda: f"where Tsit5 needs {_cell('a', 'Tsit5 rtol 1e-06', 1e-8)['steps'] / 1e5:.1f}·10⁵ (ε = 1e-8) and "
-        f"{_cell('a_eps1e-10', 'Tsit5 rtol 1e-06', 1e-10)['steps'] / 1e5:.1f}·10⁵ steps (ε = 1e-10)",
+        lambda: (
+            f"where Tsit5 needs {_cell('a', 'Tsit5 rtol 1e-06', 1e-8)['steps'] / 1e5:.1f}·10⁵ (ε = 1e-8) and "
+            f"{_cell('a_eps1e-10', 'Tsit5 rtol 1e-06', 1e-10)['steps'] / 1e5:.1f}·10⁵ steps (ε = 1e-10)"
+        ),
     ),
     # §5
     (ST, lambda: f"with a load average of {min(_loads('peers.json')):.1f}–{max(_loads('peers.json')):.1f}"),
@@ -393,8 +413,10 @@ QUOTES = [
     (ST, lambda: f"(rtol 1e-7 already gives {_e(_single('jaxcelt Dopri8', 1e-7)['error'])})"),
     (
         ST,
-        lambda: f"jaxcelt Tsit5 {_e(_single('jaxcelt Tsit5', 1e-8)['error'])}, numba DP5 "
-        f"{_e(_single('numba DP5 (hand-written)', 1e-8)['error'])}, i.e. about equal accuracy",
+        lambda: (
+            f"jaxcelt Tsit5 {_e(_single('jaxcelt Tsit5', 1e-8)['error'])}, numba DP5 "
+            f"{_e(_single('numba DP5 (hand-written)', 1e-8)['error'])}, i.e. about equal accuracy"
+        ),
     ),
     *[(ST, lambda n=n: _scal_row(n)) for n in (1, 4, 16, 64, 256, 1024, 4096)],
     *[(ST, lambda i=i: _mj_text().split(" ... ")[i]) for i in range(4)],
