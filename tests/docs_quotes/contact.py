@@ -67,7 +67,7 @@ QUOTES = [
             _s()["error_maps"]["d0"]["gen. Pade (paper constants)"]["rms"]
         ),
     ),
-    (CL, lambda: "Rolling resistance matters everywhere (:norr errors {}–{})".format(_g(min(_norr()), 2), _g(max(_norr()), 2))),
+    (CL, lambda: f"Rolling resistance matters everywhere (:norr errors {_g(min(_norr()), 2)}–{_g(max(_norr()), 2)})"),
     (CL, lambda: "(our b_Ts = {:.4f} is far from the paper's 0.5305)".format(_s()["calibration"]["generalised_pade"]["values"]["b_Ts"])),
     # ---------------------------------------------------------------- notebooks/03_contact_laws.ipynb
     (

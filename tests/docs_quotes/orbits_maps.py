@@ -65,7 +65,7 @@ def _gpu_map_f64() -> dict:
 QUOTES = [
     (MAP, lambda: "{} + {} periods (no λ₁) took {:.1f} s on one H100".format(
         _gpu_map_f64()["transient_periods"], _gpu_map_f64()["sample_periods"], _gpu_map_f64()["run_s"])),
-    (MAP, lambda: "lie up to {:.1f} s⁻¹ from their 160-period values".format(_wc_bias()[0])),
+    (MAP, lambda: f"lie up to {_wc_bias()[0]:.1f} s⁻¹ from their 160-period values"),
     (MAP, lambda: "in the {2} lanes checked they lie up to {0:.1f} s⁻¹ from their 160-period values, above them for {1}".format(
         *_wc_bias())),
     (MAP, lambda: "{} of {} cells leave the model's validity".format(
@@ -429,8 +429,7 @@ def _b_tip156() -> str:
     tip = _b_set(15.6, lambda r: r["strict"] == "invalid" and not r["allowed"].startswith("period"))
     lo, hi = min(h for h in tip if h % 180), max(h for h in tip if h < 180)
     return _check(tip, {0.0, 180.0} | _and_mirror(lo, hi),
-                  "the headings along the vibration (ψ0 = 0°, 180°) and {}–{} (and +180°) tip past 90° at 15.6 rad/s".format(
-                      _deg(lo), _deg(hi)))
+                  f"the headings along the vibration (ψ0 = 0°, 180°) and {_deg(lo)}–{_deg(hi)} (and +180°) tip past 90° at 15.6 rad/s")
 
 
 def _b_near_zero17() -> str:
@@ -454,7 +453,7 @@ def _long_row() -> str:
     c = [_cell(t["labels"][w]) for w in _W]
     lam14 = float(t["labels"]["14.0"].rpartition("λ=")[2])
     first, rest = c[2].split(", ", 1)
-    return "| 157.5° | {} (λ₁ {:.2f}) | {} | **{}**, {} | {} |".format(c[0], lam14, c[1], first, rest, c[3])
+    return f"| 157.5° | {c[0]} (λ₁ {lam14:.2f}) | {c[1]} | **{first}**, {rest} | {c[3]} |"
 
 
 QUOTES += [

@@ -980,3 +980,18 @@ QUOTES += [
     # §2's stick–slip heading is the scene's description in work_precision.json
     (ST, lambda: "### " + next(x for x in _perf("work_precision.json")["scenes"] if x["scene"] == "stick_slip")["description"]),
 ]
+
+
+def _stick_slip_steps() -> str:
+    """Section 3: steps of Kvaerno5-Newton and of Tsit5 (rtol 1e-6 to 1e-10) on the stick-slip scene."""
+    runs = next(s for s in _json("docs/performance/work_precision.json")["scenes"] if s["scene"] == "stick_slip")["runs"]
+    f64 = [r for r in runs if "steps" in r and r["dtype"] == "float64" and r["law_name"] == "generalised_pade"]
+    k5 = {r["rtol"]: r["steps"] for r in f64 if r["solver"] == "Kvaerno5-Newton"}
+    ts = [r["steps"] for r in f64 if r["solver"] == "Tsit5" and 1e-10 * 0.99 <= r["rtol"] <= 1e-6 * 1.01]
+    return (
+        f"Kvaerno5-Newton takes {k5[1e-4]} and {k5[1e-6]} steps at rtol 1e-4 and 1e-6 against "
+        f"{min(ts):,}–{max(ts):,} for Tsit5 at rtol 1e-6 to 1e-10".replace(",", " ")
+    )
+
+
+QUOTES.append((ST, _stick_slip_steps))

@@ -247,7 +247,7 @@ def _float32_check_sentence() -> str:
 QUOTES = [
     # ---------------------------------------------------------------- docs/performance.md
     (PERF, lambda: _peers_sentence()),
-    (PERF, lambda: "timed on a shared 2-core machine (load average {:.0f}–{:.0f})".format(min(_study_loads()), max(_study_loads()))),
+    (PERF, lambda: f"timed on a shared 2-core machine (load average {min(_study_loads()):.0f}–{max(_study_loads()):.0f})"),
     (
         PERF,
         lambda: "| 400 × 400 × 300-period ω_π × q_π map | one NVIDIA H100 | {:.1f} s, plus {:.1f} s compilation |".format(
