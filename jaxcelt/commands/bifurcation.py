@@ -126,13 +126,14 @@ def format_summary(ds, *, wall_seconds: float, out: Path, files: list[str], max_
 
 
 def run(args) -> int:
+    t_command = time.perf_counter()
     devices = lane_devices(args)
     import numpy as np
 
     import jaxcelt as jc
     from jaxcelt.commands._warnings import one_line_warnings
     from jaxcelt.integrate.solvers import make_solver
-    from jaxcelt.provenance import write_result
+    from jaxcelt.provenance import load_average, write_result
     from jaxcelt.sweeps.api import sweep
     from jaxcelt.sweeps.dataset import open_sweep
     from jaxcelt.sweeps.regimes import regime_runs
@@ -162,6 +163,7 @@ def run(args) -> int:
 
         pw = params.replace(omega_pi=float(args.orbits[0]))
         prepare_dense_trajectory(pw, jc.initial_state(pw, omega=omega0), **_orbit_settings(args, solver), defer=True)
+    load = load_average()
     t0 = time.perf_counter()
     with one_line_warnings("bifurcation"):  # e.g. a damaged chunk file recomputed on resume
         sweep(
@@ -198,9 +200,12 @@ def run(args) -> int:
         "lanes_invalid": int(np.sum(ds["valid"].values == 0)),
         "regimes": regime_runs(ds),
     }
-    write_result(args.out / "summary.json", summary)
+    write_result(args.out / "summary.json", summary, load_at_start=load)
     if not args.no_figures:
         _figures(args, ds, params, omega0, solver)
+    # the whole command after its imports: the sweep, the figures and the phase plots, compilation included
+    summary["command_seconds"] = round(time.perf_counter() - t_command, 2)
+    write_result(args.out / "summary.json", summary, load_at_start=load)
     files = sorted(f.name for f in args.out.iterdir() if f.is_file() and f.name != "manifest.json")
     print(format_summary(ds, wall_seconds=wall, out=args.out, files=files), flush=True)
     return 0
