@@ -13,6 +13,7 @@ from .files import (  # noqa: F401
     _json,
     _lambda14,
     _long14,
+    _machine,
     _main_job_time,
     _per_step_512,
     _processes,
@@ -297,6 +298,23 @@ QUOTES = [
     ),
     # the performance page: the README's jobs, and the 400 x 300 sweep against its peers (equal work, cores stated)
     ("docs/performance.md", lambda: f"| {_json('docs/bifurcation/summary.json')['wall_seconds_including_compile']:.1f} s for the sweep including compilation |"),
+    ("docs/performance.md", lambda: f"(60 lanes) | {_machine('docs/bifurcation/summary.json')}, 2 JAX devices, cold compile cache |"),
+    ("docs/performance.md", lambda: f"400 frequencies × 300 periods | {_machine('docs/bifurcation/summary_400x300.json')}, 2 JAX devices, cold compile cache |"),
+    (
+        "docs/bifurcation/README.md",
+        lambda: "took {:.1f} s on {}, and the whole command {:.1f} s".format(
+            _json("docs/bifurcation/summary.json")["wall_seconds_including_compile"],
+            _machine("docs/bifurcation/summary.json"),
+            _json("docs/bifurcation/summary.json")["command_seconds"],
+        ),
+    ),
+    (
+        "docs/bifurcation/README.md",
+        lambda: "**{:.2f} s including compilation** on {}".format(
+            _json("docs/bifurcation/summary_400x300.json")["wall_seconds_including_compile"],
+            _machine("docs/bifurcation/summary_400x300.json"),
+        ),
+    ),
     ("docs/performance.md", lambda: f"| {_json('docs/bifurcation/main_job_compile.json')['command_compile_overhead_s_median']:.1f} s for the whole command (median of 3 processes) |"),
     ("docs/performance.md", lambda: f"| {_json('docs/bifurcation/summary_400x300.json')['wall_seconds_including_compile']:.2f} s for the sweep including compilation |"),
     ("docs/performance.md", lambda: "load average {:.1f} at the start (no CPU model recorded) | {:.2f} s + {:.1f} s compilation |".format(

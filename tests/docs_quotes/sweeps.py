@@ -880,7 +880,8 @@ SETTINGS = [
     (ENGINE, "q_π 0.02–0.06 m"),
     ("docs/how-to/regime-labels.md", "O drifts more than 0.05 m over the samples"),
     ("docs/explanation/lane-engine.md", "(`PILOT_FRACTION` = 0.1)"),
-    ("docs/install.md", "| 3.11 | 0.10 | | ≥ 3.12 | 0.11 – 0.12 |"),
+    ("docs/install.md", "| 3.11 | 0.10 (the newest for 3.11) | 0.6.2 – 0.10 | | ≥ 3.12 | 0.12 | 0.6.2 – 0.12 |"),
+    ("docs/install.md", "JAX 0.11 and 0.12 need Python ≥ 3.12"),
     ("docs/citing.md", "doi:10.5890/DNC.2014.06.002"),
     # targets the engine is measured against, and the census' definition of a sticking lane (stiff_factor)
     (ENGINE, "Per-RHS-evaluation cost within 1.5× of the numba ensemble"),
