@@ -54,7 +54,7 @@ DECIMAL = re.compile(r"(?<![\w.\-−/])[−-]?(?:\d+\.\d+(?:\s?[eE][−-]?\d+)?|
 _SETTING_NUMBER = re.compile(r"^[−-]?1(?:\.0+)?(?:\s?[eE][−-]?\d+)$")
 _LABEL_CONTEXT = re.compile(
     r"(?:jax|jaxlib|python|diffrax|equinox|optimistix|optax|numba|numpy|scipy|cuda|mkdocs|version|v|§|section|"
-    r"sections|eq\.|eqs\.|equation|fig\.|figs\.|figure|table|step|A\d+|ε\s?=\s?ε_R\s?=)\s*$",
+    r"sections|eq\.|eqs\.|equation|fig\.|figs\.|figure|table|step|A\d+|ε\s?=\s?ε_R\s?=|\d+\.\d+\.\d+\s?[–-])\s*$",
     re.IGNORECASE,
 )
 # pages that quote no results: the model specification gives the paper's equations and parameters
