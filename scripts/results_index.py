@@ -206,7 +206,7 @@ def _git(*args: str) -> str:
     return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True).stdout.strip()
 
 
-def file_record(rel: str, writers: dict[str, str]) -> dict:
+def file_record(rel: str) -> dict:
     """What made a result file: its provenance block, else the script that writes it; and its age."""
     path = ROOT / rel
     rec: dict = {"file": rel}
@@ -228,7 +228,7 @@ def file_record(rel: str, writers: dict[str, str]) -> dict:
         rec["load"] = load[0] if load else None
         base = prov.get("commit")
     else:
-        rec["command"] = writers.get(Path(rel).name) or writers.get(rel)
+        rec["command"] = LEGACY_COMMANDS.get(rel)
         rec["commit"] = None
         rec["machine"] = None
         rec["load"] = None
@@ -242,23 +242,73 @@ def file_record(rel: str, writers: dict[str, str]) -> dict:
     return rec
 
 
-def writers() -> dict[str, str]:
-    """Result file name -> the script that writes it (for files that record no command): a scan of the scripts."""
-    out = {}
-    for script in sorted([*(ROOT / "scripts").glob("*.py"), *(ROOT / "benchmarks").glob("*.py")]):
-        src = script.read_text(encoding="utf-8")
-        for name in set(re.findall(r"[\"'/]([\w.\-{}]+\.json)[\"']", src)):
-            if "{" in name:
-                continue
-            out.setdefault(name, f"python {script.relative_to(ROOT).as_posix()}")
-    out.setdefault("summary.json", "jaxcelt bifurcation / jaxcelt map")
-    return out
+# The command that wrote each committed result file that records none (files written before the provenance
+# block; a new file records its own command). Checked by tests/test_results_index.py: every quoted file is covered.
+LEGACY_COMMANDS = {
+    "docs/bifurcation/bench_sweep_400x300.json": "python benchmarks/bench_sweep.py --n-freq 400 --periods 300 --out docs/bifurcation",
+    "docs/bifurcation/drain.json": "python benchmarks/bench_drain.py --out docs/bifurcation",
+    "docs/bifurcation/main_job_compile.json": "python benchmarks/main_job_compile.py",
+    "docs/bifurcation/max_steps_study.json": "python benchmarks/max_steps_study.py --out docs/bifurcation",
+    "docs/bifurcation/pool_width.json": "python benchmarks/bench_pool_width.py --out docs/bifurcation",
+    "docs/bifurcation/processes.json": "python benchmarks/bench_processes.py --out docs/bifurcation",
+    "docs/bifurcation/roofline.json": "python benchmarks/roofline.py --out docs/bifurcation",
+    "docs/bifurcation/step_parts.json": "python benchmarks/bench_step_parts.py --out docs/bifurcation",
+    "docs/bifurcation/vector_width.json": "python benchmarks/vector_width.py --out docs/bifurcation",
+    "docs/contact/summary.json": "python scripts/contact_study.py",
+    "docs/fit/bench_fit.json": "python benchmarks/bench_fit.py",
+    "docs/fit/chaos_multiple_gnd.json": "python scripts/fit_study.py --only chaos",
+    "docs/fit/chaos_record.json": "python scripts/fit_study.py --only chaos",
+    "docs/fit/chaos_single.json": "python scripts/fit_study.py --only chaos",
+    "docs/fit/chaos_single_gnd.json": "python scripts/fit_study.py --only chaos",
+    "docs/fit/compare.json": "python scripts/fit_study.py --only compare",
+    "docs/fit/compile_parts.json": "python benchmarks/fit_compile_parts.py",
+    "docs/fit/coverage.json": "python scripts/fit_study.py --only coverage",
+    "docs/fit/gradnorm.json": "python scripts/fit_study.py --only gradnorm",
+    "docs/fit/multistart.json": "python benchmarks/bench_multistart.py",
+    "docs/fit/records_parallel.json": "python benchmarks/fit_records_parallel.py",
+    "docs/fit/recover.json": "python scripts/fit_study.py --only recover",
+    "docs/fit/sensor_study.json": "python scripts/fit_sensor_study.py",
+    "docs/map/lyapunov_window_check.json": "python scripts/map_lyapunov_check.py",
+    "docs/map/map_omega_q_100x60.json": "python scripts/map_study.py",
+    "docs/orbits/bifurcation_grad.json": "python scripts/bifurcation_grad.py",
+    "docs/orbits/branches.json": "python scripts/orbit_branches.py",
+    "docs/orbits/celt_fold_grad.json": "python scripts/celt_fold_grad.py",
+    "docs/orbits/census.json": "python scripts/attractor_census.py",
+    "docs/orbits/census_long14/census.json": "python scripts/attractor_census.py --out docs/orbits/census_long14 --omega 14",
+    "docs/orbits/duffing_cascade.json": "python scripts/duffing_cascade.py",
+    "docs/orbits/known_answers.json": "python scripts/periodic_known_answers.py",
+    "docs/orbits/orbit_check.json": "python scripts/orbit_check.py",
+    "docs/paper-reproduction/figures_psi157.5.json": "python scripts/paper_figures.py",
+    "docs/paper-reproduction/study_eps1e-6.json": "python scripts/paper_study.py (its settings are in the file)",
+    "docs/paper-reproduction/study_eps1e-8.json": "python scripts/paper_study.py (its settings are in the file)",
+    "docs/paper-reproduction/study_eps_large.json": "python scripts/paper_study.py (its settings are in the file)",
+    "docs/paper-reproduction/study_long2000.json": "python scripts/paper_study.py (its settings are in the file)",
+    "docs/paper-reproduction/study_stageA.json": "python scripts/paper_study.py (its settings are in the file)",
+    "docs/paper-reproduction/study_tol1e-10.json": "python scripts/paper_study.py (its settings are in the file)",
+    "docs/performance/compile_options.json": "python benchmarks/compile_options.py",
+    "docs/performance/float32_periodic_check.json": "python scripts/float32_periodic_check.py",
+    "docs/performance/gpu_map.json": "python benchmarks/gpu_map.py (on a GPU)",
+    "docs/performance/gpu_map_kernel.json": "python benchmarks/gpu_map.py (on a GPU; records of separate machines)",
+    "docs/performance/map_step_census.json": "python benchmarks/map_step_census.py",
+    "docs/performance/mujoco.json": "python benchmarks/mujoco_peer.py --out docs/performance",
+    "docs/performance/mujoco_mjx.json": "python benchmarks/mujoco_peer.py --out docs/performance",
+    "docs/performance/peers.json": "python benchmarks/peers.py --out docs/performance",
+    "docs/performance/peers_idle.json": "python benchmarks/peers.py --out docs/performance --lanes 1,64,1024",
+    "docs/performance/reference.json": "python benchmarks/reference.py --out docs/performance",
+    "docs/performance/stability_a.json": "python benchmarks/stability.py --out docs/performance",
+    "docs/performance/stability_a_eps1e-10.json": "python benchmarks/stability.py --out docs/performance",
+    "docs/performance/stability_a_implicit.json": "python benchmarks/stability.py --out docs/performance",
+    "docs/performance/stability_b.json": "python benchmarks/stability.py --out docs/performance",
+    "docs/performance/stability_c.json": "python benchmarks/stability.py --out docs/performance",
+    "docs/performance/stability_d.json": "python benchmarks/stability.py --out docs/performance",
+    "docs/performance/stability_e.json": "python benchmarks/stability.py --out docs/performance",
+    "docs/performance/work_precision.json": "python benchmarks/work_precision.py --out docs/performance",
+}
 
 
 def render(quotes: list[Quote], scanned: dict[str, dict]) -> str:
-    w = writers()
     files = sorted({f for q in quotes for f in q.files})
-    recs = {f: file_record(f, w) for f in files}
+    recs = {f: file_record(f) for f in files}
     n_num = sum(len(r["verified"]) + len(r["input"]) + len(r["unverified"]) for r in scanned.values())
     n_ver = sum(len(r["verified"]) for r in scanned.values())
     n_in = sum(len(r["input"]) for r in scanned.values())

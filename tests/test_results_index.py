@@ -49,3 +49,16 @@ def test_index_page_lists_every_quoted_text_and_its_files():
     assert files and all(f"| `{f}` |" in page for f in files)
     # a quoted text that reads no committed file would be a number with nothing behind it
     assert [q.text for q in quotes if not q.files] == []
+
+
+def test_every_quoted_file_names_the_command_that_made_it():
+    # a file with a provenance block records its command; an older one is listed in LEGACY_COMMANDS, whose
+    # scripts must exist
+    idx = _index()
+    quotes, _ = idx.load_quotes()
+    for f in sorted({f for q in quotes for f in q.files if f.endswith(".json")}):
+        rec = idx.file_record(f)
+        assert rec["command"], f"{f}: no provenance block and no entry in LEGACY_COMMANDS"
+        script = rec["command"].split()[1] if rec["command"].startswith("python ") else None
+        if script:
+            assert (ROOT / script).exists(), f"{f}: {script} does not exist"
