@@ -19,6 +19,8 @@ from jaxcelt.identify.result import FitResult
 from jaxcelt.integrate.lyapunov import celt_lyapunov, largest_lyapunov
 from jaxcelt.integrate.noslip import simulate_noslip
 from jaxcelt.integrate.solve import INVALID_KINDS, STATUS, Solution, simulate
+from jaxcelt.integrate.spectrum import SpectrumResult
+from jaxcelt.integrate.spectrum import celt_lyapunov_spectrum as lyapunov_spectrum
 from jaxcelt.orbits.celt import CeltOrbit, continue_orbit, periodic_orbit
 from jaxcelt.orbits.options import ShootingOptions
 from jaxcelt.physics.contact.elliptic import contact_integrals, ellipke
@@ -77,6 +79,8 @@ __all__ = [
     "parameter_map",
     "sweep_lanes",
     "largest_lyapunov",
+    "lyapunov_spectrum",
+    "SpectrumResult",
     "CONTACT_LAWS",
     "CeltParams",
     "Diagnostics",
