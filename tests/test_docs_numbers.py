@@ -299,7 +299,7 @@ def test_gpu_kernel_table_from_json():
     comp = next(r["comparison"] for r in d["machine_2"] if "comparison" in r)
     chk = next(r["check"] for r in d["machine_1"] if "check" in r)["float64"]
     quotes = [
-        f"**Target met: {f64['run_s']:.1f} s, {earlier['run_s']:.1f} s and {final['float64']['run_s']:.1f} s**",
+        f"**The float64 map in {f64['run_s']:.1f} s, {earlier['run_s']:.1f} s and {final['float64']['run_s']:.1f} s**",
         f"64 of 64 the same status, step counts within {chk32['max_step_difference']} of each other, samples within "
         f"{chk32['max_sample_difference_rel']:.1e}".replace("e-0", "e-"),
         f"{sp(f64['status_counts']['1'])} sticking lanes stop at max_steps",

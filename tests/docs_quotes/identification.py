@@ -652,7 +652,7 @@ QUOTES = [
     (D, _adam_vs_lm),
     (D, _chaos_shooting),
     # XLA's loop emitters for the evaluation program (benchmarks/fit_compile_parts.py)
-    (D, _compile_parts),
+    ("docs/internals/fit-engine.md", _compile_parts),
     # several starts (benchmarks/bench_multistart.py)
     (D, _multistart),
     # sensor axes, time offsets and the release (scripts/fit_sensor_study.py)

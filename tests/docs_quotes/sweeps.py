@@ -737,7 +737,7 @@ QUOTES = [
     (BIF, lambda: _kernel_row("machine_4", "float32", "float32, 1e-6 (machine 4)")),
     (
         BIF,
-        lambda: "**Target met: {}** for the float64 map (three runs, each on its own H100), with {:.1f}–{:.1f} s of compilation apart".format(
+        lambda: "**The float64 map in {}** (within a minute) (three runs, each on its own H100), with {:.1f}–{:.1f} s of compilation apart".format(
             " and ".join([", ".join(f"{r['run_s']:.1f} s" for r in _float64_maps()[:2]), f"{_float64_maps()[2]['run_s']:.1f} s"]),
             min(r["compile_s"] for r in _float64_maps()),
             max(r["compile_s"] for r in _float64_maps()),
