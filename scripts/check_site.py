@@ -23,12 +23,13 @@ import threading
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-# page (site path) -> screenshot name: the home page, the install page, a tutorial with figures, an API page
+# page (site path) -> (screenshot name, window height): the home page, the install page, a tutorial with its
+# figures (tall enough to reach them), an API page
 PAGES = {
-    "": "home.png",
-    "install/": "install.png",
-    "notebooks/02_bifurcation/": "tutorial_02_bifurcation.png",
-    "api/": "api.png",
+    "": ("home.png", 1800),
+    "install/": ("install.png", 1800),
+    "notebooks/06_periodic_orbits/": ("tutorial_06_periodic_orbits.png", 5200),
+    "api/": ("api.png", 1800),
 }
 
 
@@ -69,12 +70,12 @@ def check_links(url: str, linkchecker: str) -> int:
 def screenshots(url: str, out: Path, browser: str) -> list[Path]:
     out.mkdir(parents=True, exist_ok=True)
     shots = []
-    for page, name in PAGES.items():
+    for page, (name, height) in PAGES.items():
         path = out / name
         subprocess.run(
             [
                 browser, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
-                "--window-size=1280,1800", f"--screenshot={path}", url + page,
+                f"--window-size=1280,{height}", f"--screenshot={path}", url + page,
             ],
             check=True,
             capture_output=True,
