@@ -22,6 +22,7 @@ from jaxcelt.integrate.solve import INVALID_KINDS, STATUS, Solution, simulate
 from jaxcelt.integrate.spectrum import SpectrumResult
 from jaxcelt.integrate.spectrum import celt_lyapunov_spectrum as lyapunov_spectrum
 from jaxcelt.orbits.celt import CeltOrbit, continue_orbit, periodic_orbit
+from jaxcelt.orbits.curves import BifurcationCurve, continue_bifurcation
 from jaxcelt.orbits.options import ShootingOptions
 from jaxcelt.physics.contact.elliptic import contact_integrals, ellipke
 from jaxcelt.physics.contact.integral import (
@@ -58,6 +59,8 @@ __all__ = [
     "CeltOrbit",
     "periodic_orbit",
     "continue_orbit",
+    "continue_bifurcation",
+    "BifurcationCurve",
     "ShootingOptions",
     "FitResult",
     "FitOptions",

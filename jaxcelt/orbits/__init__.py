@@ -14,6 +14,8 @@ The model-agnostic layer they are built on, module by module:
   `trace_arclength`, and `branch_to_dict`.
 * `jaxcelt.orbits.points` -- bifurcation points on a branch: detection (test functions), location (bisection),
   and refinement with implicit-function-theorem derivatives (`locate_bifurcation`, bordered test functions).
+* `jaxcelt.orbits.curves` -- `continue_bifurcation`: a fold or period-doubling point continued in two parameters
+  (its curve, with cusps, fold-flip and 1:1 / 1:2 resonance points located on it).
 * `jaxcelt.orbits.switching` -- `switch_at_period_doubling`: the period-2k orbit that starts a new branch.
 * `jaxcelt.orbits.celt` -- the wobblestone's chart of the contact manifold (`celt_chart`, `celt_embed`) and the
   entry points above.
@@ -36,6 +38,14 @@ from jaxcelt.orbits.celt import (
     continue_orbit,
     locate_orbit_bifurcation,
     periodic_orbit,
+)
+from jaxcelt.orbits.curves import (
+    CODIM2_TESTS,
+    CURVE_STATUS,
+    BifurcationCurve,
+    CurvePoint,
+    continue_bifurcation,
+    curve_to_dict,
 )
 from jaxcelt.orbits.options import ShootingOptions
 from jaxcelt.orbits.points import (
@@ -84,4 +94,10 @@ __all__ = [
     "locate_period_doubling",
     "locate_fold",
     "switch_at_period_doubling",
+    "continue_bifurcation",
+    "BifurcationCurve",
+    "CurvePoint",
+    "CURVE_STATUS",
+    "CODIM2_TESTS",
+    "curve_to_dict",
 ]

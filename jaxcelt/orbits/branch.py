@@ -223,39 +223,52 @@ def trace_arclength(
     ds_min: float,
     ds_max: float,
     callback: Callable[[int, float, bool], None] | None = None,
+    stop: Callable[[np.ndarray], str | None] | None = None,
 ) -> tuple[dict[str, list], str]:
     """Points after ``u0``, following the branch from it in ``direction`` of lam, and why the trace stopped.
 
-    Returns ``dict(ref=[...], lam=[...], t=[t0, ...], obs=[...], h=[...])`` (host values; ``t`` has the start's
-    tangent first) and "end value reached" (``passed(lam)``), "max points" (``budget``) or "step below ds_min".
+    Returns ``dict(ref=[...], lam=[...], t=[t0, ...], obs=[...], h=[...], u=[...], shrunk=[...])`` (host values,
+    ``ref`` and ``obs`` may be pytrees of arrays; ``t`` has the start's tangent first; ``u`` the accepted unknowns,
+    each in the chart around its own point; ``shrunk`` whether the step was halved before that point was
+    accepted) and "end value reached" (``passed(lam)``), "max points" (``budget``), "step below ds_min" or the
+    reason ``stop(u)`` returned (an optional check of each accepted point on all its unknowns; None: go on).
     The step is halved when the corrector fails and grown x1.5 (up to ``ds_max``) when it converges in at most 3
     Newton iterations.
     """
     ref, u = ref0, u0
     t = stepper.tangent(u, ref, jnp.zeros(u.shape[0]).at[-1].set(direction))
-    out = dict(ref=[], lam=[], t=[np.asarray(t)], obs=[], h=[])
-    h, stopped = ds, "max points"
+    out = dict(ref=[], lam=[], t=[np.asarray(t)], obs=[], h=[], u=[], shrunk=[])
+    h, stopped, shrunk = ds, "max points", False
+    host = lambda tree: jax.tree_util.tree_map(np.asarray, tree)  # noqa: E731
     while len(out["ref"]) < budget:
         u_new, good, nsteps = stepper.corrector(u, t, h, ref)
         if callback is not None:
             callback(len(out["ref"]) + 1, float(u_new[-1]) if bool(good) else float(u[-1]), bool(good))
         if not bool(good):
             h *= 0.5
+            shrunk = True
             if h < ds_min:
                 stopped = "step below ds_min"
                 break
             continue
         u, t, ref = stepper.recentre(u_new, t, ref)
         t = stepper.tangent(u, ref, t)
-        out["ref"].append(np.asarray(ref))
+        out["ref"].append(host(ref))
         out["lam"].append(float(u[-1]))
         out["t"].append(np.asarray(t))
-        out["obs"].append(np.asarray(stepper.observe(u, ref)))
+        out["obs"].append(host(stepper.observe(u, ref)))
         out["h"].append(h)
+        out["u"].append(np.asarray(u))
+        out["shrunk"].append(shrunk)
+        shrunk = False
         if int(nsteps) <= 3:
             h = min(1.5 * h, ds_max)
         if passed(out["lam"][-1]):
             stopped = "end value reached"
+            break
+        reason = stop(out["u"][-1]) if stop is not None else None
+        if reason is not None:
+            stopped = reason
             break
     return out, stopped
 

@@ -139,6 +139,7 @@ def variational_map(
     period: Scalar,
     k: int = 1,
     t0: Scalar = 0.0,
+    forward_mode: bool = False,
     options: ShootingOptions | None = None,
     **settings: Unpack[ShootingKeywords],
 ) -> tuple[Array, Array, Array, Array]:
@@ -149,7 +150,9 @@ def variational_map(
     This is the accurate monodromy: the derivative of the primal-only discrete flow (what
     `jax.jacfwd` of `stroboscopic_map` gives) can be far off where the primal error estimate
     does not see the tangent dynamics (e.g. at an equilibrium y = 0, where steps grow unbounded).
-    Options as in `stroboscopic_map`.
+    Options as in `stroboscopic_map`. ``forward_mode=True`` makes the solve forward-mode differentiable
+    (``jax.jvp``/``jax.jacfwd``, e.g. derivatives of the monodromy in the state and parameters, as
+    `jaxcelt.orbits.curves` needs); the default is reverse-mode differentiable instead.
     """
     opts = resolve_options(options, _DEFAULTS, caller="variational_map", **settings)
     y0 = jnp.asarray(y0)
@@ -161,7 +164,7 @@ def variational_map(
         return fy, JPhi
 
     state0 = (y0, jnp.eye(y0.shape[0], dtype=y0.dtype))
-    sol = _flow(field, state0, args, period=period, k=k, t0=t0, options=opts, forward_mode=False)
+    sol = _flow(field, state0, args, period=period, k=k, t0=t0, options=opts, forward_mode=forward_mode)
     y1, Phi = (x[-1] for x in sol.ys)
     return y1, Phi, sol.result == diffrax.RESULTS.successful, sol.stats["num_steps"]
 
