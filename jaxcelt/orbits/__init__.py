@@ -36,6 +36,7 @@ from jaxcelt.orbits.celt import (
     celt_chart,
     celt_embed,
     continue_orbit,
+    continue_orbit_bifurcation,
     locate_orbit_bifurcation,
     periodic_orbit,
 )
@@ -70,6 +71,7 @@ __all__ = [
     "periodic_orbit",
     "continue_orbit",
     "locate_orbit_bifurcation",
+    "continue_orbit_bifurcation",
     "CeltOrbit",
     "celt_chart",
     "celt_embed",
