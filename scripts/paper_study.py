@@ -135,8 +135,9 @@ def relabel_file(path: Path) -> dict:
     )
     # the rows were integrated earlier: keep that run's provenance beside the re-labelling's
     measured = d.pop("provenance", None)
-    if measured is not None:
-        d["provenance_of_integration"] = measured
+    d["provenance_of_integration"] = d.get("provenance_of_integration") or measured or (
+        "not recorded: the rows were integrated before result files recorded their provenance"
+    )
     write_result(path, d, default=str)
     return d
 
