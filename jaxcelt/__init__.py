@@ -21,7 +21,8 @@ from jaxcelt.integrate.noslip import simulate_noslip
 from jaxcelt.integrate.solve import INVALID_KINDS, STATUS, Solution, simulate
 from jaxcelt.integrate.spectrum import SpectrumResult
 from jaxcelt.integrate.spectrum import celt_lyapunov_spectrum as lyapunov_spectrum
-from jaxcelt.orbits.celt import CeltOrbit, continue_orbit, continue_orbit_bifurcation, periodic_orbit
+from jaxcelt.orbits.celt import CeltOrbit, continue_orbit, periodic_orbit
+from jaxcelt.orbits.celt_curves import continue_orbit_bifurcation
 from jaxcelt.orbits.curves import BifurcationCurve, continue_bifurcation
 from jaxcelt.orbits.options import ShootingOptions
 from jaxcelt.physics.contact.elliptic import contact_integrals, ellipke

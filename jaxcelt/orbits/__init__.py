@@ -36,10 +36,10 @@ from jaxcelt.orbits.celt import (
     celt_chart,
     celt_embed,
     continue_orbit,
-    continue_orbit_bifurcation,
     locate_orbit_bifurcation,
     periodic_orbit,
 )
+from jaxcelt.orbits.celt_curves import continue_orbit_bifurcation
 from jaxcelt.orbits.curves import (
     CODIM2_TESTS,
     CURVE_STATUS,
