@@ -21,6 +21,9 @@
   either side of it.
 """
 
+import importlib.util
+from pathlib import Path
+
 import jax.numpy as jnp
 import numpy as np
 import pytest
@@ -31,33 +34,21 @@ import jaxcelt as jc
 from jaxcelt.orbits.branch import continue_arclength
 from jaxcelt.orbits.curves import CODIM2_TESTS, codim2_tests
 
-DELTA = 0.2
+
+def _problems():
+    """The test problems, defined once in scripts/bifurcation_curves_check.py (which writes the committed results)."""
+    spec = importlib.util.spec_from_file_location(
+        "bifurcation_curves_check", Path(__file__).resolve().parents[1] / "scripts" / "bifurcation_curves_check.py"
+    )
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
 
 
-def mathieu(t, y, p):
-    a, q = p
-    return jnp.stack([y[1], -(a - 2 * q * jnp.cos(2 * t)) * y[0]])
-
-
-def duffing(t, y, p):
-    w, F = p
-    return jnp.stack([y[1], -DELTA * y[1] - y[0] - y[0] ** 3 + F * jnp.cos(w * t)])
-
-
-def mathieu_args(a, q):
-    return (a, q)
-
-
-def duffing_args(w, F):
-    return (w, F)
-
-
-def pi_period(p):
-    return jnp.pi
-
-
-def duffing_period(p):
-    return 2 * jnp.pi / p[0]
+_P = _problems()
+DELTA, mathieu, duffing, mathieu_args, duffing_args, pi_period, duffing_period = (
+    _P.DELTA, _P.mathieu, _P.duffing, _P.mathieu_args, _P.duffing_args, _P.pi_period, _P.duffing_period
+)
 
 
 def test_codim2_test_functions():
