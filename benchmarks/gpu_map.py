@@ -51,6 +51,10 @@ def main() -> int:
     ap.add_argument("--transient", type=int, default=270)
     ap.add_argument("--sample", type=int, default=30)
     ap.add_argument("--dtype", default="float64", choices=("float64", "float32"))
+    ap.add_argument("--field-dtype", default=None, choices=("float32",), help="mixed precision: the field in float32")
+    ap.add_argument("--stiffness", default="off", choices=("off", "auto"), help="the kernel's stiffness switch")
+    ap.add_argument("--omega", nargs=2, type=float, default=(10.0, 20.0), help="omega_pi range")
+    ap.add_argument("--q", nargs=2, type=float, default=(0.02, 0.06), help="q_pi range")
     ap.add_argument("--rtol", type=float, default=1e-8)
     ap.add_argument("--atol", type=float, default=1e-10)
     ap.add_argument("--chunk", type=int, default=None, help="lanes per pool launch (default: all)")
@@ -89,14 +93,14 @@ def main() -> int:
     ver = versions()
     print(json.dumps(ver), flush=True)
     p = jc.CeltParams.paper()
-    xs = np.linspace(10.0, 20.0, a.nx)
-    ys = np.linspace(0.02, 0.06, a.ny)
+    xs = np.linspace(*a.omega, a.nx)
+    ys = np.linspace(*a.q, a.ny)
     L = a.nx * a.ny
     cs = min(a.chunk or L, L)
     W = a.width or cs
     kw = dict(
         transient_periods=a.transient, sample_periods=a.sample, rtol=a.rtol, atol=a.atol, stop_on_invalid=True,
-        dtype=a.dtype,
+        dtype=a.dtype, field_dtype=a.field_dtype, stiffness=a.stiffness,
     )  # fmt: skip
     # compile for the map's own shapes: chunk 0's lanes, padded to the chunk size, all marked padding
     lane_x = np.repeat(xs, a.ny)[:cs]
@@ -127,6 +131,10 @@ def main() -> int:
         "transient_periods": a.transient,
         "sample_periods": a.sample,
         "dtype": a.dtype,
+        "field_dtype": a.field_dtype,
+        "stiffness": a.stiffness,
+        "omega_pi": list(a.omega),
+        "q_pi": list(a.q),
         "rtol": a.rtol,
         "atol": a.atol,
         "chunk": cs,

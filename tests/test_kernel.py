@@ -16,7 +16,7 @@ import pytest
 
 import jaxcelt as jc
 from jaxcelt.ensemble import BLOCK, SweepConfig, blockwise, lanes_params, run_lanes
-from jaxcelt.ensemble.kernel import make_segment
+from jaxcelt.ensemble.kernel import KERNEL_FIELDS, make_segment
 from jaxcelt.ensemble.soa import as_blocks, from_blocks
 from jaxcelt.physics.contact.registry import get_contact_law
 from jaxcelt.physics.model import vector_field_and_normal
@@ -132,7 +132,7 @@ def test_kernel_lowers_for_cuda_without_a_gpu():
     seg = make_segment(cfg, params_of, 2)
     L = 2 * BLOCK
     z, zi = jnp.zeros(L), jnp.zeros(L, jnp.int32)
-    flat = [z] * 26 + [z, z, zi, zi, z, zi, z, z]
+    flat = [z] * 26 + [zi if k in ("num_steps", "code", "first_invalid_kind", "stiff", "stiff_count", "stiff_steps") else z for k in KERNEL_FIELDS]
     lowered = jax.jit(lambda flat, tg, pv: seg(flat, tg, tg, tg, pv, False)).trace(flat, z, (z, z))
     text = lowered.lower(lowering_platforms=("cuda",)).as_text()
     assert "triton" in text

@@ -41,11 +41,23 @@ class SweepConfig:
     t0: float = 0.0
     stop_on_invalid: bool = False
     """end a lane at the first accepted step whose end state is invalid (status 2, later samples inf)"""
+    stiffness: str = "off"
+    """the lane kernel's stiffness switch (`jaxcelt.ensemble.stiff`): ``"auto"`` steps a lane with
+    Rodas4P while its explicit steps are stability-limited (a stone sticking to the base), ``"off"``
+    (default) keeps every step explicit. The pool's steps are the solver's alone"""
+    field_dtype: str | None = None
+    """mixed precision in the lane kernel: ``"float32"`` evaluates the field in float32 while the
+    state, the stage sums and the error control stay in `dtype` (float64); None (default): the field
+    in `dtype`. The pool has no mixed precision"""
     dtype: str = "float64"
     """"float64" (default) or "float32": the lanes' arithmetic (times stay float64 with an explicit FSAL
     solver, `jaxcelt.ensemble.float64_times`; the Lyapunov stage stays float64)"""
 
     def __post_init__(self):
+        if self.stiffness not in ("auto", "off"):
+            raise ValueError(f"'stiffness' must be 'auto' or 'off', got {self.stiffness!r}")
+        if self.field_dtype not in (None, "float32", "float64"):
+            raise ValueError(f"'field_dtype' must be None, 'float32' or 'float64', got {self.field_dtype!r}")
         if self.dtype not in ("float64", "float32"):
             raise ValueError(f"'dtype' must be 'float64' or 'float32', got {self.dtype!r}")
         for name in ("transient_periods", "sample_periods", "lyapunov_periods", "max_steps"):
@@ -77,6 +89,8 @@ class SweepConfig:
             t0=float(self.t0),
             stop_on_invalid=int(bool(self.stop_on_invalid)),
             dtype=str(self.dtype),
+            **({} if self.stiffness == "off" else {"stiffness": str(self.stiffness)}),
+            **({} if self.field_dtype is None else {"field_dtype": str(self.field_dtype)}),
         )
 
 

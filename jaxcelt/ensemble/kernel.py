@@ -39,6 +39,7 @@ import numpy as np
 
 from jaxcelt._types import Array
 from jaxcelt.ensemble.soa import blockwise
+from jaxcelt.ensemble.stiff import step_either
 from jaxcelt.ensemble.stepper import erk_tableau
 from jaxcelt.integrate.solve import MIN_STEP_ULPS
 from jaxcelt.physics.contact.registry import get_contact_law
@@ -49,10 +50,21 @@ __all__ = ["BLOCK", "kernel_supported", "make_segment", "run_kernel_lanes", "KER
 BLOCK = 32
 """lanes per kernel program: one warp, one lane per thread"""
 
-KERNEL_FIELDS = ("tprev", "tnext", "num_steps", "code", "first_invalid_t", "first_invalid_kind", "min_N", "min_n3")
-"""per-lane scalars of the kernel's state besides y (13) and the FSAL derivative f (13). ``code``:
-0 running or done, 2 stopped at an invalid state, 3 step size collapsed (`jaxcelt.STATUS`)"""
-_INT = ("num_steps", "code", "first_invalid_kind")
+KERNEL_FIELDS = ("tprev", "tnext", "num_steps", "code", "first_invalid_t", "first_invalid_kind", "min_N", "min_n3",
+                 "stiff", "stiff_count", "stiff_steps")  # fmt: skip
+"""per-lane scalars of the kernel's state besides y (n) and the FSAL derivative f (n). ``code``:
+0 running or done, 2 stopped at an invalid state, 3 step size collapsed (`jaxcelt.STATUS`);
+``stiff``: 1 while the lane takes the stiff step (`jaxcelt.ensemble.stiff`), ``stiff_count`` its
+switch's counter, ``stiff_steps`` the stiff steps taken"""
+_INT = ("num_steps", "code", "first_invalid_kind", "stiff", "stiff_count", "stiff_steps")
+
+
+def _pick(i: Array, col: list[float], dtype: Any) -> Array:
+    """col[i] for a traced index: a chain of scalar selects (no constant arrays in a kernel)."""
+    out = jnp.asarray(col[-1], dtype)
+    for r in range(len(col) - 2, -1, -1):
+        out = jnp.where(i == r, jnp.asarray(col[r], dtype), out)
+    return out
 
 
 def kernel_supported(solver: Any) -> bool:
@@ -74,13 +86,28 @@ def _triton_params() -> Any:
 
 
 class _Segment:
-    """The kernel of one call: every lane of a block to its target time (module docstring)."""
+    """The kernel of one call: every lane of a block to its target time (module docstring).
 
-    def __init__(self, cfg: Any, params_of: Any, nvary: int, dtype: Any):
-        law = get_contact_law(cfg.contact_law)
+    ``field``: a per-lane function ``(t, y, pv) -> (dy/dt, (N, den))`` of the state's dtype, with
+    the normal force N and the denominator ``den`` of the heading rate that the validity monitor
+    reads, or None for the wobblestone's (`jaxcelt.physics.model.vector_field_and_normal`);
+    ``n``: the state's size; ``omega_of``: the forcing frequency of a lane's parameter values
+    (for `field_time`; None: times pass unchanged); ``n3_index``: the state component read as n3
+    by the monitor (None: none)."""
+
+    def __init__(self, cfg: Any, params_of: Any, nvary: int, dtype: Any, *, field: Any = None, n: int = 13,
+                 omega_of: Any = None, n3_index: int | None = 8):  # fmt: skip
         tab = erk_tableau(cfg.solver)
         if tab is None:
-            raise ValueError(f"the lane kernel needs an explicit FSAL Runge-Kutta solver, got {type(cfg.solver).__name__}")
+            raise ValueError(
+                f"the lane kernel needs an explicit FSAL Runge-Kutta solver, got {type(cfg.solver).__name__}"
+            )
+        if field is None:
+            law = get_contact_law(cfg.contact_law)
+            field = lambda t, y, pv: vector_field_and_normal(t, y, params_of(pv), law)  # noqa: E731
+            omega_of = lambda pv: params_of(pv).omega_pi  # noqa: E731
+        self.n = int(n)
+        self.n3_index = n3_index
         self.dtype = np.dtype(dtype)
         self.c = [float(x) for x in np.asarray(tab.c, dtype=float)]
         ns = len(self.c)  # stages after the first (FSAL) one
@@ -97,67 +124,74 @@ class _Segment:
         self.q = float(cfg.solver.error_order(diffrax.ODETerm(lambda t, y, a: y)))
         self.max_steps = int(cfg.max_steps)
         self.stop_on_invalid = bool(cfg.stop_on_invalid)
+        # the stiffness switch (`jaxcelt.ensemble.stiff`): on where asked and the tableau's last two
+        # stages share their time (the explicit step's stiffness estimate needs it)
+        self.stiff = getattr(cfg, "stiffness", "off") == "auto" and ns >= 2 and self.c[-1] == self.c[-2]
         self.nvary = nvary
-        one = np.zeros((), self.dtype)
+        # mixed precision: the field in float32, the state, its sums and the error control in float64
+        self.fdtype = np.dtype(getattr(cfg, "field_dtype", None) or dtype)
+        one = np.zeros((), self.fdtype)
         ex_pv = tuple(one for _ in range(nvary))
-        self.rhs = blockwise(lambda t, y, pv: vector_field_and_normal(t, y, params_of(pv), law), one,
-                             np.zeros(13, self.dtype), ex_pv)  # fmt: skip
-        self.omega_of = lambda pv: params_of(pv).omega_pi
+        ex_y = np.zeros(self.n, self.fdtype)
+        self.rhs = blockwise(field, one, ex_y, ex_pv)
+        if self.stiff:
+
+            def tangent(t, y, pv, tt, ty):
+                return jax.jvp(lambda t_, y_: field(t_, y_, pv)[0], (t, y), (tt, ty))
+
+            self.rhs_jvp = blockwise(tangent, one, ex_y, ex_pv, one, ex_y)
+        self.omega_of = omega_of
 
     def field_time(self, t: Array, pv: tuple[Array, ...]) -> Array:
-        """The time the field is evaluated at, in the state's dtype (`jaxcelt.physics.model.field_time`): the
+        """The time the field is evaluated at, in the field's dtype (`jaxcelt.physics.model.field_time`): the
         kernel's times are float64; a float32 field gets the forcing phase from one period."""
-        return field_time(t, self.omega_of(pv), self.dtype)
+        pv = tuple(x.astype(self.fdtype) for x in pv)
+        if self.omega_of is None:
+            return t.astype(self.fdtype)
+        return field_time(t, self.omega_of(pv), self.fdtype)
+
+    def _full(self, e: Any, shape: tuple[int, ...]) -> Array:
+        """A field output as a block in the state's dtype."""
+        return e.astype(self.dtype) if np.ndim(e) == 1 else jnp.full(shape, np.asarray(e), self.dtype)
+
+    def _obj(self, y: list[Array]) -> np.ndarray:
+        yo = np.empty(self.n, dtype=object)
+        for m, e in enumerate(y):
+            yo[m] = e.astype(self.fdtype)
+        return yo
 
     def field(self, t: Array, y: list[Array], pv: tuple[Array, ...]) -> tuple[list[Array], Array, Array]:
         t = self.field_time(t, pv)
-        yo = np.empty(13, dtype=object)
-        for m, e in enumerate(y):
-            yo[m] = e
-        f, (N, den) = self.rhs(t, yo, pv)
-        full = lambda e: e if np.ndim(e) == 1 else jnp.full(t.shape, np.asarray(e), self.dtype)  # noqa: E731
-        return [full(e) for e in f], full(N[()]), full(den[()])
+        f, (N, den) = self.rhs(t, self._obj(y), tuple(x.astype(self.fdtype) for x in pv))
+        return [self._full(e, t.shape) for e in f], self._full(N[()], t.shape), self._full(den[()], t.shape)
 
-    def step(self, s: dict, target: Array, t1: Array, floor: Array, pv: tuple[Array, ...]) -> tuple[dict, Array]:
-        """One step of every lane of the block that is still short of ``target``: (the new state, which lanes stepped)."""
+    def field_tangent(self, t: Array, y: list[Array], pv: tuple[Array, ...], tt: Array,
+                      ty: list[Array]) -> tuple[list[Array], list[Array]]:  # fmt: skip
+        """The field and its derivative along (tt, ty) in (t, y)."""
+        t = self.field_time(t, pv)
+        f, df = self.rhs_jvp(t, self._obj(y), tuple(x.astype(self.fdtype) for x in pv), tt.astype(self.fdtype),
+                             self._obj(ty))  # fmt: skip
+        return [self._full(e, t.shape) for e in f], [self._full(e, t.shape) for e in df]
+
+    def validity(self, y1: list[Array], N: Array, den: Array) -> Array:
+        """0 valid, else the first failed condition: 3 heading singular, 2 n3 <= 0, 1 N <= 0."""
+        n3 = y1[self.n3_index] if self.n3_index is not None else jnp.ones_like(N)
+        return jnp.where(den <= 0, 3, jnp.where(n3 <= 0, 2, jnp.where(N <= 0, 1, 0))).astype(jnp.int32)
+
+    def control(self, s: dict, y0: list[Array], y1: list[Array], err: list[Array], dt: Array, q: float,
+                target: Array, t1: Array, floor: Array) -> dict:  # fmt: skip
+        """diffrax's PID controller (I-control) with exponent 1/q on the scaled RMS error, the step
+        clipped onto the section time, diffeqsolve's end-of-interval rounding."""
         dt_ = self.dtype
-        y0, f0, t0 = s["y"], s["f"], s["tprev"]
-        act = (s["code"] == 0) & (s["num_steps"] < self.max_steps) & (t0 < target)
-        dt = s["tnext"] - t0  # times in float64 (`field_time`)
-        dts = dt.astype(dt_)
-        ns = len(self.c)
-        zero = jnp.zeros(t0.shape, dt_)
-        ks = [[f * dts for f in f0]] + [[zero] * 13 for _ in range(ns)]
-
-        def pick(i, col, dtype=dt_):  # col[i] for a traced stage index: a chain of scalar selects (no constant arrays in a kernel)
-            out = jnp.asarray(col[-1], dtype)
-            for r in range(len(col) - 2, -1, -1):
-                out = jnp.where(i == r, jnp.asarray(col[r], dtype), out)
-            return out
-
-        def stage(i, carry):
-            ks, _, _, _, _ = carry
-            coef = [pick(i, [float(x) for x in self.a[:, j]]) for j in range(ns)]
-            yi = [y0[m] + sum(coef[j] * ks[j][m] for j in range(ns) if self.a[:, j].any()) for m in range(13)]
-            fi, N, den = self.field(t0 + pick(i, self.c, jnp.float64) * dt, yi, pv)
-            new = [f * dts for f in fi]
-            ks = [ks[0]] + [[jnp.where(i + 1 == j, new[m], ks[j][m]) for m in range(13)] for j in range(1, ns + 1)]
-            return ks, yi, fi, N, den
-
-        ks, yi, fi, N, den = jax.lax.fori_loop(0, ns, stage, (ks, y0, f0, zero, zero))
-        if self.fsal_is_y1:
-            y1 = yi
-        else:
-            y1 = [y0[m] + sum(float(self.b[j]) * ks[j][m] for j in range(ns + 1) if self.b[j] != 0) for m in range(13)]
-        err = [sum(float(self.e[j]) * ks[j][m] for j in range(ns + 1) if self.e[j] != 0) for m in range(13)]
+        t0 = s["tprev"]
         err = [jnp.where(jnp.isnan(x), jnp.inf, x) for x in err]
         y1_nan = functools.reduce(jnp.logical_or, [jnp.isnan(x) for x in y1])
         y1s = [jnp.where(y1_nan, a, b) for a, b in zip(y0, y1)]
         r = [x / (self.atol + jnp.maximum(jnp.abs(a), jnp.abs(b)) * self.rtol) for x, a, b in zip(err, y0, y1s)]
-        scaled = jnp.sqrt(sum(x * x for x in r)) / np.sqrt(13.0).astype(dt_)
+        scaled = jnp.sqrt(sum(x * x for x in r)) / np.sqrt(float(self.n)).astype(dt_)
         keep = scaled < 1
         factor = jnp.clip(
-            self.safety * (1 / scaled) ** (1.0 / self.q),
+            self.safety * (1 / scaled) ** (1.0 / q),
             jnp.where(keep, 1.0, self.fmin).astype(dt_),
             jnp.where(keep, self.fmax, self.safety).astype(dt_),
         )
@@ -168,31 +202,90 @@ class _Segment:
         small = ~keep & ~((span >= MIN_STEP_ULPS * jnp.abs(tprev) * np.finfo(np.float64).eps) & (span > 0))
         tprev = jnp.minimum(tprev, t1)  # diffeqsolve's end-of-interval rounding
         tnext = jnp.where(tnext > floor, jnp.where(keep, t1, tprev + 0.5 * (t1 - tprev)), tnext)
-        kind = jnp.where(den <= 0, 3, jnp.where(y1[8] <= 0, 2, jnp.where(N <= 0, 1, 0))).astype(jnp.int32)
+        return dict(keep=keep, tprev=tprev, tnext=tnext, small=small)
+
+    def explicit(
+        self, s: dict, pv: tuple[Array, ...]
+    ) -> tuple[list[Array], list[Array], list[Array], Array, Array, Array]:
+        """One explicit step from every lane's state: (y1, its derivative, the error, N, den, h rho)
+        with rho the stiffness estimate |f(y7) - f(y6)| / |y7 - y6| of the last two stages (0
+        where the switch is off)."""
+        dt_ = self.dtype
+        n = self.n
+        y0, f0, t0 = s["y"], s["f"], s["tprev"]
+        dt = s["tnext"] - t0  # times in float64 (`field_time`)
+        dts = dt.astype(dt_)
+        ns = len(self.c)
+        zero = jnp.zeros(t0.shape, dt_)
+        ks = [[f * dts for f in f0]] + [[zero] * n for _ in range(ns)]
+
+        def stage(i, carry):
+            ks, yi, fi, _, _, yp, fp = carry
+            coef = [_pick(i, [float(x) for x in self.a[:, j]], dt_) for j in range(ns)]
+            yn = [y0[m] + sum(coef[j] * ks[j][m] for j in range(ns) if self.a[:, j].any()) for m in range(n)]
+            fn, N, den = self.field(t0 + _pick(i, self.c, jnp.float64) * dt, yn, pv)
+            new = [f * dts for f in fn]
+            ks = [ks[0]] + [[jnp.where(i + 1 == j, new[m], ks[j][m]) for m in range(n)] for j in range(1, ns + 1)]
+            return ks, yn, fn, N, den, yi, fi
+
+        ks, yi, fi, N, den, yp, fp = jax.lax.fori_loop(0, ns, stage, (ks, y0, f0, zero, zero, y0, f0))
+        if self.fsal_is_y1:
+            y1 = yi
+        else:
+            y1 = [y0[m] + sum(float(self.b[j]) * ks[j][m] for j in range(ns + 1) if self.b[j] != 0) for m in range(n)]
+        err = [sum(float(self.e[j]) * ks[j][m] for j in range(ns + 1) if self.e[j] != 0) for m in range(n)]
+        if self.stiff:
+            num = sum((a - b) * (a - b) for a, b in zip(fi, fp))
+            den2 = sum((a - b) * (a - b) for a, b in zip(yi, yp))
+            hrho = jnp.abs(dts) * jnp.sqrt(num / jnp.where(den2 > 0, den2, jnp.inf))
+        else:
+            hrho = zero
+        return y1, fi, err, N, den, hrho
+
+    def step(self, s: dict, target: Array, t1: Array, floor: Array, pv: tuple[Array, ...]) -> tuple[dict, Array]:
+        """One step of every lane of the block that is still short of ``target``: (the new state, which lanes stepped)."""
+        y0, f0, t0 = s["y"], s["f"], s["tprev"]
+        act = (s["code"] == 0) & (s["num_steps"] < self.max_steps) & (t0 < target)
+        dt = s["tnext"] - t0
+        if self.stiff:
+            y1, f1, err, N, den, q, mode, count = step_either(self, s, pv, act)
+        else:
+            y1, f1, err, N, den, _ = self.explicit(s, pv)
+            q = self.q
+        ctl = self.control(s, y0, y1, err, dt, q, target, t1, floor)
+        keep = ctl["keep"]
+        kind = self.validity(y1, N, den)
         new_invalid = keep & (kind > 0) & (s["first_invalid_kind"] == 0)
-        code = jnp.where(small & (s["code"] == 0), 3, s["code"])
+        code = jnp.where(ctl["small"] & (s["code"] == 0), 3, s["code"])
         if self.stop_on_invalid:
             code = jnp.where(new_invalid & (code == 0), 2, code)
+        n3 = y1[self.n3_index] if self.n3_index is not None else s["min_n3"]
         new = dict(
             y=[jnp.where(keep, a, b) for a, b in zip(y1, y0)],
-            f=[jnp.where(keep, a, b) for a, b in zip(fi, f0)],
-            tprev=tprev,
-            tnext=tnext,
+            f=[jnp.where(keep, a, b) for a, b in zip(f1, f0)],
+            tprev=ctl["tprev"],
+            tnext=ctl["tnext"],
             num_steps=s["num_steps"] + 1,
             code=code.astype(jnp.int32),
-            first_invalid_t=jnp.where(new_invalid, tprev, s["first_invalid_t"]),
+            first_invalid_t=jnp.where(new_invalid, ctl["tprev"], s["first_invalid_t"]),
             first_invalid_kind=jnp.where(new_invalid, kind, s["first_invalid_kind"]),
             min_N=jnp.where(keep, jnp.minimum(s["min_N"], N), s["min_N"]),
-            min_n3=jnp.where(keep, jnp.minimum(s["min_n3"], y1[8]), s["min_n3"]),
+            min_n3=jnp.where(keep, jnp.minimum(s["min_n3"], n3), s["min_n3"]),
+            stiff=s["stiff"],
+            stiff_count=s["stiff_count"],
+            stiff_steps=s["stiff_steps"],
         )
+        if self.stiff:
+            new["stiff_steps"] = s["stiff_steps"] + (s["stiff"] > 0).astype(jnp.int32)
+            new["stiff"], new["stiff_count"] = mode, count
         return jax.tree_util.tree_map(lambda a, b: jnp.where(act, a, b), new, s), act
 
     def kernel(self, *refs):
-        nst = 26 + len(KERNEL_FIELDS)
+        nst = 2 * self.n + len(KERNEL_FIELDS)
         ins = refs[: nst + 3 + self.nvary]
         outs = refs[nst + 3 + self.nvary :]
         vals = [r[...] for r in ins]
-        s = _unflatten(vals[:nst])
+        s = _unflatten(vals[:nst], self.n)
         target, t1, floor = vals[nst : nst + 3]
         pv = tuple(vals[nst + 3 :])
         s["tnext"] = jnp.where(s["tprev"] < target, jnp.minimum(s["tnext"], target), s["tnext"])
@@ -235,9 +328,9 @@ def _flatten(s: dict) -> list[Array]:
     return list(s["y"]) + list(s["f"]) + [s[k] for k in KERNEL_FIELDS]
 
 
-def _unflatten(v: list[Array]) -> dict:
-    s = dict(y=list(v[:13]), f=list(v[13:26]))
-    s.update(zip(KERNEL_FIELDS, v[26:]))
+def _unflatten(v: list[Array], n: int) -> dict:
+    s = dict(y=list(v[:n]), f=list(v[n : 2 * n]))
+    s.update(zip(KERNEL_FIELDS, v[2 * n :]))
     return s
 
 
@@ -267,6 +360,9 @@ def run_kernel_lanes(
         first_invalid_kind=st.first_invalid_kind.astype(jnp.int32),
         min_N=st.min_N,
         min_n3=st.min_n3,
+        stiff=jnp.zeros(L, jnp.int32),
+        stiff_count=jnp.zeros(L, jnp.int32),
+        stiff_steps=jnp.zeros(L, jnp.int32),
     )
     # padding lanes (done at the start without a reason) are parked: a step budget of zero
     parked = lanes0.done & (code == 0)
@@ -285,7 +381,7 @@ def run_kernel_lanes(
 
     flat = _flatten(s)
     (flat, iters), samples = jax.lax.scan(section, (flat, jnp.zeros((L,), jnp.int32)), ts_all.T)
-    s = _unflatten(flat)
+    s = _unflatten(flat, 13)
     samples = jnp.swapaxes(samples, 0, 1).astype(dt_)
     ok = s["code"] == 0
     num_steps = jnp.where(parked, lanes0.num_steps, s["num_steps"])
@@ -298,5 +394,6 @@ def run_kernel_lanes(
         first_invalid_kind=s["first_invalid_kind"],
         min_N=s["min_N"],
         max_tilt=jnp.arccos(jnp.clip(s["min_n3"], -1, 1)),
+        stiff_steps=s["stiff_steps"],
     )
     return out, samples, iters

@@ -28,7 +28,7 @@ import numpy as np
 __all__ = ["blockwise", "as_blocks", "from_blocks", "is_block"]
 
 _ELEMENTWISE = frozenset(
-    """abs acos acosh add and asin asinh atan atan2 atanh bitcast_convert_type cbrt ceil clamp
+    """abs acos acosh add add_any and asin asinh atan atan2 atanh bitcast_convert_type cbrt ceil clamp
     convert_element_type copy copy_p cos cosh div eq erf exp exp2 expm1 floor ge gt imag integer_pow
     is_finite le log log1p logistic lt max min mul ne neg nextafter not or pow real reduce_precision rem
     round rsqrt select_n shift_left shift_right_arithmetic shift_right_logical sign sin sinh sqrt square
@@ -83,6 +83,7 @@ def _apply(prim: Any, params: dict, elems: list[Any], dtypes: list[Any]) -> Any:
 
 
 def _elementwise(eqn: Any, *xs: np.ndarray) -> list[np.ndarray]:
+    prim = jax.lax.add_p if eqn.primitive.name == "add_any" else eqn.primitive  # a derivative's sum of tangents
     shapes = {x.shape for x in xs if x.shape != ()}
     shape = shapes.pop() if shapes else ()
     if shapes:
@@ -92,8 +93,8 @@ def _elementwise(eqn: Any, *xs: np.ndarray) -> list[np.ndarray]:
     nout = len(eqn.outvars) if eqn.primitive.multiple_results else 1
     outs = [np.empty(shape, dtype=object) for _ in range(nout)]
     for idx in np.ndindex(shape):
-        r = _apply(eqn.primitive, eqn.params, [x[idx] for x in xs], dtypes)
-        for o, v in zip(outs, r if eqn.primitive.multiple_results else [r]):
+        r = _apply(prim, eqn.params, [x[idx] for x in xs], dtypes)
+        for o, v in zip(outs, r if prim.multiple_results else [r]):
             o[idx] = v
     return outs
 

@@ -312,6 +312,11 @@ def _run_lanes(
     platform = (list(devices)[0] if devices else jax.local_devices()[0]).platform
     on_gpu = platform in ("gpu", "cuda", "rocm")
     use_kernel = engine == "kernel" or (engine == "auto" and on_gpu and kernel_supported(cfg.solver))
+    if not use_kernel and (cfg.field_dtype not in (None, cfg.dtype) or cfg.stiffness != "off"):
+        raise ValueError(
+            "field_dtype, stiffness: mixed precision and the stiffness switch are the lane kernel's "
+            "(engine='kernel', or 'auto' on a GPU)"
+        )
     per = ndev * (BLOCK if use_kernel else 1)  # the kernel's programs take whole blocks of lanes
     Lp = math.ceil(max(L, pad_to or 0) / per) * per
     pb_np = jax.tree_util.tree_map(lambda x: pad_lanes(np.asarray(x), Lp), pb)

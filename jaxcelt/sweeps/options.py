@@ -48,6 +48,11 @@ class SweepOptions:
             (`jaxcelt.physics.model.field_time`); with other solvers float32 lanes step in float32
             time, and a step below ~10 ULPs of t ends a lane (status 3). Part of the dataset's
             fingerprint.
+        field_dtype: mixed precision in the lane kernel: ``"float32"`` evaluates the field in float32
+            while the state, its sums and the error control stay float64; None (default): off.
+        stiffness: the lane kernel's stiffness switch (`jaxcelt.ensemble.stiff`): ``"auto"`` steps a
+            lane with Rodas4P while its explicit steps are stability-limited (a stone sticking to the
+            base); ``"off"`` (default): explicit steps only.
 
     Execution (results do not depend on these beyond rounding, see `jaxcelt.sweeps.driver`):
 
@@ -83,6 +88,8 @@ class SweepOptions:
     t0: float = 0.0
     stop_on_invalid: bool = False
     dtype: Any = "float64"
+    field_dtype: str | None = None
+    stiffness: str = "off"
     chunk_size: int | None = None
     sort_by_cost: bool = False
     width: int | None = None
@@ -110,6 +117,8 @@ class SweepOptions:
             t0=float(self.t0),
             stop_on_invalid=bool(self.stop_on_invalid),
             dtype=_dtype_name(self.dtype),
+            field_dtype=None if self.field_dtype is None else _dtype_name(self.field_dtype),
+            stiffness=self.stiffness,
         )
 
 
