@@ -43,6 +43,8 @@ from jaxcelt.physics.state import check_state, constraint_residual, initial_stat
 from jaxcelt.studies.ladder import Scene, hertz_params, run_ladder
 from jaxcelt.sweeps.api import bifurcation, parameter_map, sweep_lanes
 from jaxcelt.sweeps.census import AttractorCensus, AttractorStarts, attractor_starts, attractors
+from jaxcelt.sweeps.continuation import continue_attractors
+from jaxcelt.sweeps.continuation_options import ContinuationOptions
 from jaxcelt.sweeps.following import continuation
 from jaxcelt.sweeps.following import follow_attractor as follow_attractor  # new name of continuation
 from jaxcelt.sweeps.options import SweepOptions
@@ -57,6 +59,8 @@ __all__ = [
     "AttractorStarts",
     "attractor_starts",
     "attractors",
+    "continue_attractors",
+    "ContinuationOptions",
     "CeltOrbit",
     "periodic_orbit",
     "continue_orbit",

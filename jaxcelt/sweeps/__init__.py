@@ -8,6 +8,9 @@ Entry points:
 * `following`: `follow_attractor`, each value started from the previous value's final state
   (hysteresis; formerly ``continuation``);
 * `census`: `attractors`, the distinct attractors reached from many starts at one parameter value;
+* `continuation`: `continue_attractors`, global continuation of the attractors over one parameter (seeds from
+  the previous value, matching, basin fractions; resumable), on the model-agnostic `continuation_core`
+  (`continue_section_attractors`, any forced ODE via `continuation_ode.forced_ode_model`);
 * `dense`: `dense_trajectory`, many states per period at one value, for phase plots.
 
 Their parts:
@@ -16,6 +19,8 @@ Their parts:
 * `result`: `SweepResult` and the lane schema (`LANE_FIELDS`, `LANE_DIMS`);
 * `driver`: `run_batch` -- chunks, resumable writing, several processes (`jax.distributed`);
 * `dataset`: the xarray/netCDF files (``out/sweep.nc``, chunk files, manifest) and their resume;
+* `continuation_options` (`ContinuationOptions`), `continuation_match` (lane kinds, grouping, matching),
+  `continuation_store` (one resumable file per value), `continuation_result` (the continuation's dataset);
 * `regimes`: regime labels (period-k, quasi-periodic, chaotic, ...) and regime ranges along a sweep.
 
 The lanes themselves run on `jaxcelt.ensemble`; periodic orbits and their continuation along a
@@ -32,6 +37,9 @@ from jaxcelt.sweeps.census import AttractorStarts as AttractorStarts
 from jaxcelt.sweeps.census import attractor_starts as attractor_starts
 from jaxcelt.sweeps.census import attractors as attractors
 from jaxcelt.sweeps.census import refine_attractor as refine_attractor
+from jaxcelt.sweeps.continuation import continue_attractors as continue_attractors
+from jaxcelt.sweeps.continuation_core import continue_section_attractors as continue_section_attractors
+from jaxcelt.sweeps.continuation_options import ContinuationOptions as ContinuationOptions
 from jaxcelt.sweeps.dense import dense_trajectory as dense_trajectory
 from jaxcelt.sweeps.dense import prepare_dense_trajectory as prepare_dense_trajectory
 from jaxcelt.sweeps.driver import run_batch as run_batch
