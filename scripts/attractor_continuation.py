@@ -2,8 +2,9 @@
 
 `jaxcelt.continue_attractors` with the paper's stone (`CeltParams.paper`), 64 fresh starts at rest
 (`jaxcelt.attractor_starts`: 16 headings psi0 over a full turn x 4 tilts in +-0.1 rad), the same at every
-value, plus 4 seeds from each attractor of the previous value; 200 transient periods, 16 section samples;
-periodic attractors refined by `jaxcelt.periodic_orbit` (Floquet multipliers). Values: 10, 10.5, ..., 20 and
+value, plus 4 seeds from each attractor of the previous value; 200 transient periods, 16 section samples, the
+largest Lyapunov exponent over 100 periods (labels non-periodic attractors chaotic / quasi-periodic /
+uncertain); periodic attractors refined by `jaxcelt.periodic_orbit` (Floquet multipliers). Values: 10, 10.5, ..., 20 and
 15.6 (the paper's frequency). Resumable: the per-value files go to ``--work`` (default
 ``out/attractor_continuation``); a rerun reads finished values back.
 
@@ -12,7 +13,8 @@ table per value, the attractor sets at 14, 15.6, 17 and 19 rad/s, times) and
 docs/orbits/attractor_continuation.png (stacked basin fractions with tipping over; the attractors' section
 coordinates omega_2 and psi against omega_pi).
 
-    python scripts/attractor_continuation.py [--starts 16 4] [--transient 200] [--sample 16] [--plot-only]
+    python scripts/attractor_continuation.py [--starts 16 4] [--transient 200] [--sample 16] [--lyapunov 100]
+        [--work DIR] [--plot-only]
 """
 
 from __future__ import annotations
@@ -44,7 +46,7 @@ def run(args) -> dict:
     t0 = time.perf_counter()
     ds = jc.continue_attractors(
         p, "omega_pi", values(), starts=starts, transient_periods=args.transient, sample_periods=args.sample,
-        seeds_per_attractor=4, refine=True, out=args.work, progress=True,
+        seeds_per_attractor=4, refine=True, lyapunov_periods=args.lyapunov, out=args.work, progress=True,
     )  # fmt: skip
     wall = time.perf_counter() - t0
     summary = continuation_summary(ds)
@@ -76,7 +78,7 @@ def run(args) -> dict:
             sample_periods=args.sample,
             seeds_per_attractor=4,
             refine=True,
-            lyapunov_periods=0,
+            lyapunov_periods=args.lyapunov,
             solver="default (SweepOptions)",
         ),  # fmt: skip
         wall_s=round(wall, 1),
@@ -92,6 +94,8 @@ def _name(a: dict) -> dict:
     if a["kind"] == "periodic":
         out.update(multiplier_max=a["multiplier_max"], stable=a["stable"], refine_status=a["refine_status"],
                    psi_deg=float(np.degrees(a["section_point"][12]) % 360), omega2=a["section_point"][4])  # fmt: skip
+    else:
+        out.update(lyapunov=a["lyapunov"], lyapunov_stderr=a["lyapunov_stderr"])
     return out
 
 
@@ -185,6 +189,7 @@ def main(argv=None) -> None:
     ap.add_argument("--starts", type=int, nargs=2, default=[16, 4], metavar=("N_PSI0", "N_TILT"))
     ap.add_argument("--transient", type=int, default=200)
     ap.add_argument("--sample", type=int, default=16)
+    ap.add_argument("--lyapunov", type=int, default=100, help="periods of the largest Lyapunov exponent (0: off)")
     ap.add_argument("--work", default=str(ROOT / "out" / "attractor_continuation"))
     ap.add_argument("--plot-only", action="store_true")
     args = ap.parse_args(argv)
