@@ -1,5 +1,5 @@
-"""Two-parameter curves of the wobblestone's orbit bifurcations: a fold or period doubling of a period-k orbit
-(`jaxcelt.orbits.celt`) continued in two `CeltParams` fields by `jaxcelt.orbits.curves.continue_bifurcation`, in the
+"""Two-parameter curves of the wobblestone's orbit bifurcations: a fold, period doubling or Neimark-Sacker point
+of a period-k orbit (`jaxcelt.orbits.celt`) continued in two `CeltParams` fields by `jaxcelt.orbits.curves.continue_bifurcation`, in the
 chart of the contact manifold."""
 
 from __future__ import annotations
@@ -67,7 +67,7 @@ def continue_orbit_bifurcation(
     options: ShootingOptions | None = None,
     **settings: Unpack[ShootingKeywords],
 ) -> BifurcationCurve:
-    """Continue a fold or period doubling of a wobblestone period-k orbit in two parameters.
+    """Continue a fold, period doubling or Neimark-Sacker point of a wobblestone period-k orbit in two parameters.
 
     `jaxcelt.orbits.curves.continue_bifurcation` in the chart of the contact manifold (`celt_embed`,
     `celt_chart`; section t0 = 0), the two parameters ``names = (p1, p2)`` being scalar `CeltParams`
@@ -84,7 +84,9 @@ def continue_orbit_bifurcation(
         names: (p1, p2): two different scalar `CeltParams` fields (or ``"a=b"`` groups).
         bounds: ((p1_lo, p1_hi), (p2_lo, p2_hi)) containing the start; each end of the curve stops when it
             leaves this box.
-        kind: ``"fold"`` (a multiplier at +1) or ``"period-doubling"`` (-1).
+        kind: ``"fold"`` (a multiplier at +1), ``"period-doubling"`` (-1) or ``"neimark-sacker"`` (a complex pair
+            on the unit circle; `jaxcelt.orbits.curves.BifurcationCurve.kappa` is the cosine of its angle). The
+            mirror orbit (psi -> psi + pi, `jaxcelt.orbits.celt`) has its own curve: start from its state.
         k: forcing periods per return.
         direction, scale, ds, ds_min, ds_max, max_points, detect, locate_steps, callback: as in
             `jaxcelt.orbits.curves.continue_bifurcation` (the arclength is measured in the 8 chart

@@ -1,24 +1,24 @@
-"""Curves of fold and period-doubling points in two parameters (codimension-two continuation).
+"""Curves of fold, period-doubling and Neimark-Sacker points in two parameters (codimension-two continuation).
 
 A period-k orbit of a periodically forced ODE dy/dt = f(t, y, args(p1, p2)) has a fold where a Floquet
-multiplier is +1 and a period doubling where one is -1. In two parameters these points form curves. A point of
-such a curve is a regular root of the minimally augmented system (n + 1 equations in n + 2 unknowns)
+multiplier is +1, a period doubling where one is -1 and a Neimark-Sacker point where a complex pair e^{+-i theta}
+lies on the unit circle. In two parameters these points form curves; a curve point is a regular root of a
+minimally augmented system: the orbit equations chart(P(embed(z))) - z = 0 (P the k-period stroboscopic map, z
+local coordinates ``embed``/``chart`` as `jaxcelt.orbits.shooting.find_periodic_orbit` takes them) and
 
-    G(z, p1, p2) = [ chart(P(embed(z))) - z ; g(z, p1, p2) ] = 0,
+* fold / period doubling: one bordered test function of M -+ I (`jaxcelt.orbits.curve_fold.FoldSystem`);
+* Neimark-Sacker: two entries of the 2 x 2 block of the two-bordered B = M^2 - 2 kappa M + I with kappa =
+  cos(theta) an extra unknown (`jaxcelt.orbits.ns_system.NSSystem`).
 
-with P the k-period stroboscopic map, z local coordinates (``embed``/``chart``, as
-`jaxcelt.orbits.shooting.find_periodic_orbit` takes them) and g the bordered test function of A = M + s I
-(`jaxcelt.orbits.points.bordered_test_function`; s = -1 for a fold, +1 for a period doubling; M the monodromy in
-local coordinates). `continue_bifurcation` follows the curve by pseudo-arclength continuation
-(`jaxcelt.orbits.branch.ArclengthStepper`, `trace_arclength`) in u = (z, p1 / s1, p2 / s2) (``scale`` = (s1, s2)
-makes the two parameters comparable in the arclength), so it passes turning points of the curve in either
-parameter. At every accepted point the chart is re-centred on the orbit and the bordering vectors b, c are
-refreshed to the near-null vectors of A there (`jaxcelt.orbits.points.bordering_vectors`, signs kept continuous).
+`continue_bifurcation` follows the curve by pseudo-arclength continuation (`jaxcelt.orbits.branch.ArclengthStepper`,
+`trace_arclength`) in u = (z, [kappa,] p1 / s1, p2 / s2) (``scale`` = (s1, s2) makes the two parameters comparable
+in the arclength), so it passes turning points of the curve in either parameter. At every accepted point the chart
+is re-centred on the orbit and the borders are refreshed there.
 
 The monodromy M comes from the variational equations integrated with the orbit under one error control
 (`jaxcelt.orbits.shooting.variational_map` in forward mode), not from differentiating the primal-only map: on an
 orbit at an equilibrium (the trivial orbit of the Mathieu equation) the primal error estimate does not see the
-tangent dynamics. Newton's Jacobian of G is ``jax.jacfwd`` of that solve.
+tangent dynamics. Newton's Jacobian is ``jax.jacfwd`` of that solve.
 
 Codimension-two points detected along a curve (`CODIM2_TESTS`), each located between two curve points by a
 secant (Illinois) iteration in the arclength on its test function, every iterate a corrector solve:
@@ -28,13 +28,18 @@ secant (Illinois) iteration in the arclength on its test function, every iterate
   the curve, so a changes sign at a cusp); ``"1:1 resonance"``, Re prod over the other multipliers of (mu - 1);
   ``"fold-flip"``, Re prod over the other multipliers of (mu + 1);
 * period-doubling curve: ``"fold-flip"``, Re prod over the other multipliers of (mu - 1) (a second multiplier
-  through +1); ``"1:2 resonance"``, Re prod over the other multipliers of (mu + 1) (a second multiplier at -1).
+  through +1); ``"1:2 resonance"``, Re prod over the other multipliers of (mu + 1) (a second multiplier at -1);
+* Neimark-Sacker curve: ``"1:1 resonance"``, ``"1:2 resonance"``, ``"1:3 resonance"``, ``"1:4 resonance"``
+  (kappa = 1, -1, -1/2, 0: theta = 0, pi, 2 pi / 3, pi / 2), ``"fold-NS"``, ``"flip-NS"`` (Re prod over the
+  multipliers other than the pair of (mu - 1), (mu + 1)). Past kappa = +-1 the curve goes on as a neutral-saddle
+  curve (a real pair mu, 1/mu: not a bifurcation); `BifurcationCurve.kappa` tells them apart.
 
 "The other multipliers" are all but the one nearest +1 (fold) or -1 (period doubling). The 1:1 and 1:2 tests
-vanish identically along the curve of an area-preserving map (a conservative 2-d system such as the Mathieu
-equation has a double multiplier -1 all along its period-doubling curves): leave them out with ``detect=``
-there. Not detected: the degenerate flip (cubic coefficient of the flip normal form) and points where a complex
-pair crosses the unit circle on the curve (fold-Neimark-Sacker, flip-Neimark-Sacker).
+of fold and period-doubling curves vanish identically along the curve of an area-preserving map (a conservative
+2-d system such as the Mathieu equation has a double multiplier -1 all along its period-doubling curves): leave
+them out with ``detect=`` there. Not detected: the degenerate flip (cubic coefficient of the flip normal form),
+the Chenciner point (first Lyapunov coefficient of the Neimark-Sacker normal form) and points where a complex pair
+crosses the unit circle on a fold or period-doubling curve.
 """
 
 from __future__ import annotations
@@ -50,9 +55,11 @@ import numpy as np
 from jaxcelt import _config  # noqa: F401
 from jaxcelt._types import Array
 from jaxcelt.orbits.branch import ArclengthStepper, trace_arclength
+from jaxcelt.orbits.curve_fold import FoldSystem, codim2_tests
+from jaxcelt.orbits.ns_system import NS_TESTS, NSSystem
 from jaxcelt.orbits.options import ShootingKeywords, ShootingOptions, resolve_options
-from jaxcelt.orbits.points import BIFURCATION_POINT_KINDS, bordered_test_function, bordering_vectors
-from jaxcelt.orbits.shooting import Chart, chart_monodromy, sort_multipliers, variational_map
+from jaxcelt.orbits.points import BIFURCATION_POINT_KINDS
+from jaxcelt.orbits.shooting import Chart
 
 __all__ = [
     "CURVE_STATUS",
@@ -74,6 +81,7 @@ CURVE_STATUS = {
 CODIM2_TESTS = {
     "fold": ("cusp", "1:1 resonance", "fold-flip"),
     "period-doubling": ("fold-flip", "1:2 resonance"),
+    "neimark-sacker": NS_TESTS,
 }
 """curve kind -> the codimension-two points detected on it (the default of ``detect=``)"""
 
@@ -101,6 +109,8 @@ class CurvePoint(NamedTuple):
     """indices of the curve points it lies between"""
     converged: bool
     """the secant iteration reached |test| below 1e-6 of the bracket's largest |test|"""
+    kappa: float | None = None
+    """kappa = cos(theta) of the critical pair there (Neimark-Sacker curves; None otherwise)"""
 
 
 class BifurcationCurve(NamedTuple):
@@ -108,7 +118,7 @@ class BifurcationCurve(NamedTuple):
     order)."""
 
     kind: str
-    """"fold" or "period-doubling\""""
+    """"fold", "period-doubling" or "neimark-sacker\""""
     p1: np.ndarray
     """(m,)"""
     p2: np.ndarray
@@ -116,7 +126,8 @@ class BifurcationCurve(NamedTuple):
     y: np.ndarray
     """orbit states (m, n) at the section time"""
     multipliers: np.ndarray
-    """Floquet multipliers (m, d) in chart coordinates, by decreasing modulus; one is at +1 (fold) or -1"""
+    """Floquet multipliers (m, d) in chart coordinates, by decreasing modulus; one is at +1 (fold) or -1, or a
+    pair at e^{+-i theta} (Neimark-Sacker)"""
     tests: dict[str, np.ndarray]
     """test function of each detected kind of point (m,) (`CODIM2_TESTS`)"""
     status: np.ndarray
@@ -133,87 +144,18 @@ class BifurcationCurve(NamedTuple):
     "left the bounds", "max points" or "step below ds_min\""""
     start: int
     """index of the start point"""
+    kappa: np.ndarray | None = None
+    """(m,) kappa = cos(theta) of the pair e^{+-i theta} on the unit circle (Neimark-Sacker curves; None
+    otherwise). |kappa| > 1: a neutral saddle (a real pair mu, 1/mu), not a Neimark-Sacker point"""
 
-
-def codim2_tests(mu: np.ndarray, kind: str) -> dict[str, float]:
-    """The multiplier test functions of a curve point (all of `CODIM2_TESTS` but the cusp)."""
-    s0 = -BIFURCATION_POINT_KINDS[kind]  # the critical multiplier: +1 fold, -1 period doubling
-    mu = np.asarray(mu)
-    others = np.delete(mu, int(np.argmin(np.abs(mu - s0))))
-    same, opposite = float(np.prod(others - s0).real), float(np.prod(others + s0).real)
-    if kind == "fold":
-        return {"1:1 resonance": same, "fold-flip": opposite}
-    return {"1:2 resonance": same, "fold-flip": opposite}
-
-
-class _Curve(NamedTuple):
-    """The augmented system of a curve and what is observed at its points (pure, jittable methods)."""
-
-    vector_field: Callable[[Any, Array, Any], Array]
-    args_of: Callable[[Array, Array], Any]
-    period_of: Callable[[Any], Array]
-    shift: float
-    scale: tuple[float, float]
-    k: int
-    t0: float
-    embed: Chart
-    chart: Chart
-    options: ShootingOptions
-    cusp: bool
-
-    def args(self, u):
-        return self.args_of(u[-2] * self.scale[0], u[-1] * self.scale[1])
-
-    def map_and_monodromy(self, z, args, y_ref):
-        y = self.embed(z, y_ref, args)
-        y1, Phi, ok, _ = variational_map(
-            self.vector_field, y, args, period=self.period_of(args), k=self.k, t0=self.t0, forward_mode=True,
-            options=self.options,
-        )  # fmt: skip
-        M = chart_monodromy(self.embed, self.chart, z, y1, y_ref, args, Phi)
-        return self.chart(y1, y_ref, args), M, ok
-
-    def residual(self, u, ref):
-        y_ref, b, c = ref
-        z = u[:-2]
-        w1, M, ok = self.map_and_monodromy(z, self.args(u), y_ref)
-        g = bordered_test_function(M + self.shift * jnp.eye(z.shape[0]), b, c)
-        return jnp.concatenate([w1 - z, g[None]]), ok
-
-    def bordering(self, u, y_ref, b_old, c_old):
-        _, M, _ = self.map_and_monodromy(u[:-2], self.args(u), y_ref)
-        b, c = bordering_vectors(M + self.shift * jnp.eye(M.shape[0]))
-        return b * jnp.sign(jnp.dot(b, b_old) + 1e-300), c * jnp.sign(jnp.dot(c, c_old) + 1e-300)
-
-    def recentre(self, u, t, ref):
-        y_ref, b, c = ref
-        y = self.embed(u[:-2], y_ref, self.args(u))
-
-        def to_new(v):
-            a = self.args(v)
-            return jnp.concatenate([self.chart(self.embed(v[:-2], y_ref, a), y, a), v[-2:]])
-
-        u_new, t_new = jax.jvp(to_new, (u,), (t,))
-        # b, c: carried into the new chart only through their signs (they are re-computed there)
-        b_new, c_new = self.bordering(u_new, y, b, c)
-        return u_new, t_new / jnp.linalg.norm(t_new), (y, b_new, c_new)
-
-    def observe(self, u, ref):
-        y_ref, b, c = ref
-        z, args = u[:-2], self.args(u)
-        _, M, _ = self.map_and_monodromy(z, args, y_ref)
-        n = z.shape[0]
-        A = M + self.shift * jnp.eye(n)
-        border = jnp.block([[A, b[:, None]], [c[None, :], jnp.zeros((1, 1))]])
-        e = jnp.zeros(n + 1).at[n].set(1.0)
-        q = jnp.linalg.solve(border, e)[:n]  # A q ~ 0, c.q = 1: oriented like c
-        p = jnp.linalg.solve(border.T, e)[:n]  # A^T p ~ 0, b.p = 1
-        out = dict(multipliers=sort_multipliers(jnp.linalg.eigvals(M)), y=self.embed(z, y_ref, args))
-        if self.cusp:
-            # B(q, q) = d/de M(z + e q) q at e = 0; a = 1/2 <p, B(q, q)> with |q| = 1, <p, q> = 1
-            Bqq = jax.jvp(lambda zz: self.map_and_monodromy(zz, args, y_ref)[1] @ q, (z,), (q,))[1]
-            out["cusp"] = 0.5 * jnp.dot(p, Bqq) / (jnp.dot(p, q) * jnp.linalg.norm(q))
-        return out
+    @property
+    def theta(self) -> np.ndarray | None:
+        """(m,) the pair's angle arccos(kappa) in [0, pi] (nan where |kappa| > 1); None but on Neimark-Sacker
+        curves."""
+        if self.kappa is None:
+            return None
+        k = np.asarray(self.kappa)
+        return np.where(np.abs(k) <= 1.0, np.arccos(np.clip(k, -1.0, 1.0)), np.nan)
 
 
 def continue_bifurcation(
@@ -241,7 +183,7 @@ def continue_bifurcation(
     options: ShootingOptions | None = None,
     **settings: Unpack[ShootingKeywords],
 ) -> BifurcationCurve:
-    """Continue a fold or period-doubling point of a period-k orbit in two parameters (p1, p2).
+    """Continue a fold, period-doubling or Neimark-Sacker point of a period-k orbit in two parameters (p1, p2).
 
     Args:
         vector_field: ``f(t, y, args)``, T-periodic in t.
@@ -250,9 +192,11 @@ def continue_bifurcation(
             ``dataclasses.replace``).
         period_of: ``args -> T``, the forcing period (may depend on p1, p2).
         p_start: (p1, p2) near a point of the curve; the start is refined at fixed p2 (Newton on the augmented
-            system with p1 free), so p2 must be a parameter the curve crosses there.
+            system with p1 free), so p2 must be a parameter the curve crosses there. Neimark-Sacker: kappa starts
+            at cos(arg mu) of the complex multiplier nearest the unit circle at the guess.
         bounds: ((p1_lo, p1_hi), (p2_lo, p2_hi)): each end of the curve stops once it leaves this box.
-        kind: ``"fold"`` (a multiplier +1) or ``"period-doubling"`` (-1).
+        kind: ``"fold"`` (a multiplier +1), ``"period-doubling"`` (-1) or ``"neimark-sacker"`` (a complex pair
+            e^{+-i theta}; kappa = cos(theta) is returned in `BifurcationCurve.kappa`).
         direction: +1 / -1 follow the curve from the start towards increasing / decreasing p2 only; 0 both ways.
         scale: (s1, s2): the arclength is measured in (z, p1 / s1, p2 / s2).
         ds, ds_min, ds_max: initial, smallest and largest arclength step; the step is halved when the corrector
@@ -273,8 +217,8 @@ def continue_bifurcation(
     Returns:
         `BifurcationCurve` (host arrays, in curve order from the decreasing-p2 end).
     """
-    if kind not in BIFURCATION_POINT_KINDS:
-        raise ValueError(f"kind must be one of {sorted(BIFURCATION_POINT_KINDS)}, got {kind!r}")
+    if kind not in CODIM2_TESTS:
+        raise ValueError(f"kind must be one of {sorted(CODIM2_TESTS)}, got {kind!r}")
     detect = tuple(CODIM2_TESTS[kind] if detect is None else detect)
     unknown = sorted(set(detect) - set(CODIM2_TESTS[kind]))
     if unknown:
@@ -287,21 +231,22 @@ def continue_bifurcation(
     opts = resolve_options(options, CURVE_DEFAULTS, caller="continue_bifurcation", **settings)
     embed, chart = embed or _identity, chart or _identity
     s1, s2 = (float(x) for x in scale)
-    curve = _Curve(
-        vector_field, args_of, period_of, BIFURCATION_POINT_KINDS[kind], (s1, s2), k, t0, embed, chart, opts,
-        "cusp" in detect,
-    )  # fmt: skip
-    bordering, stepper = _stepper(curve)
+    if kind == "neimark-sacker":
+        curve = NSSystem(vector_field, args_of, period_of, (s1, s2), k, t0, embed, chart, opts)
+    else:
+        curve = FoldSystem(
+            vector_field, args_of, period_of, BIFURCATION_POINT_KINDS[kind], (s1, s2), k, t0, embed, chart, opts,
+            "cusp" in detect,
+        )  # fmt: skip
+    start_of, stepper = _stepper(curve)
 
-    # the start: the chart around y_guess, bordering vectors there, Newton at fixed p2
+    # the start: the chart around y_guess, borders there (and kappa of the pair nearest the unit circle), Newton
+    # at fixed p2
     y_guess = jnp.asarray(y_guess, dtype=float)
     p1, p2 = jnp.asarray(p_start[0], float), jnp.asarray(p_start[1], float)
     z0 = chart(y_guess, y_guess, args_of(p1, p2))
-    u = jnp.concatenate([z0, jnp.stack([p1 / s1, p2 / s2])])
-    n = z0.shape[0]
-    ones = jnp.ones(n) / np.sqrt(n)
-    ref = (y_guess, *bordering(u, y_guess, ones, ones))
-    fixed_p2 = jnp.zeros(n + 2).at[-1].set(1.0)
+    u, ref = start_of(z0, jnp.stack([p1 / s1, p2 / s2]), y_guess)
+    fixed_p2 = jnp.zeros(u.shape[0]).at[-1].set(1.0)
     good = False
     for _ in range(_START_TRIES):
         u_new, good, _ = stepper.corrector(u, fixed_p2, 0.0, ref)
@@ -348,9 +293,7 @@ def continue_bifurcation(
         status[-1] = 2
 
     def tests_of(obs) -> dict[str, float]:
-        out = codim2_tests(obs["multipliers"], kind)
-        if "cusp" in detect:
-            out["cusp"] = float(obs["cusp"])
+        out = curve.tests(obs, kind)
         return {name: out[name] for name in detect}
 
     tests = [tests_of(o) for o in OBS]
@@ -380,6 +323,7 @@ def continue_bifurcation(
         points=points,
         stopped=(s_lo, s_hi),
         start=start,
+        kappa=np.asarray([float(o["kappa"]) for o in OBS]) if kind == "neimark-sacker" else None,
     )
 
 
@@ -388,14 +332,14 @@ def _identity(z: Array, ref: Array, args: Any) -> Array:
 
 
 @functools.lru_cache(maxsize=16)
-def _cached_stepper(curve: _Curve) -> tuple[Callable, ArclengthStepper]:
-    return jax.jit(curve.bordering), ArclengthStepper.build(
+def _cached_stepper(curve: FoldSystem | NSSystem) -> tuple[Callable, ArclengthStepper]:
+    return jax.jit(curve.start), ArclengthStepper.build(
         curve.residual, curve.recentre, curve.observe, newton_tol=curve.options.newton_tol,
         newton_max_steps=curve.options.newton_max_steps,
     )  # fmt: skip
 
 
-def _stepper(curve: _Curve) -> tuple[Callable, ArclengthStepper]:
+def _stepper(curve: FoldSystem | NSSystem) -> tuple[Callable, ArclengthStepper]:
     """The jitted stepper of ``curve``, kept for the next call with the same functions and settings (so that a
     second call does not compile again); built afresh where a setting is unhashable."""
     try:
@@ -405,11 +349,11 @@ def _stepper(curve: _Curve) -> tuple[Callable, ArclengthStepper]:
     return _cached_stepper(curve)
 
 
-def _in_chart(curve: _Curve, u: np.ndarray, ref: Any, ref_new: Any) -> np.ndarray:
+def _in_chart(curve: FoldSystem | NSSystem, u: np.ndarray, ref: Any, ref_new: Any) -> np.ndarray:
     """u (in the chart of ``ref``) in the chart of ``ref_new``."""
-    a = curve.args(jnp.asarray(u))
-    y = curve.embed(jnp.asarray(u[:-2]), jnp.asarray(ref[0]), a)
-    return np.concatenate([np.asarray(curve.chart(y, jnp.asarray(ref_new[0]), a)), u[-2:]])
+    a, e = curve.args(jnp.asarray(u)), curve.extra
+    y = curve.embed(jnp.asarray(u[:-e]), jnp.asarray(ref[0]), a)
+    return np.concatenate([np.asarray(curve.chart(y, jnp.asarray(ref_new[0]), a)), u[-e:]])
 
 
 def _locate(stepper, curve, tests_of, name, u_a, ref_a, t_a, h_b, ta, tb, iters, bracket, obs_a, obs_b):
@@ -446,8 +390,9 @@ def _locate(stepper, curve, tests_of, name, u_a, ref_a, t_a, h_b, ta, tb, iters,
         u, mu, y = np.asarray(u), obs["multipliers"], obs["y"]
         conv = abs(f) <= 1e-6 * max(abs(ta), abs(tb))
     s1, s2 = curve.scale
+    kappa = float(u[-3]) if curve.extra == 3 else None
     return CurvePoint(name, float(u[-2] * s1), float(u[-1] * s2), np.asarray(y), np.asarray(mu), float(f), bracket,
-                      bool(conv))  # fmt: skip
+                      bool(conv), kappa)  # fmt: skip
 
 
 def _pairs(mu: np.ndarray) -> list[list[float]]:
@@ -469,11 +414,12 @@ def curve_to_dict(curve: BifurcationCurve, names: tuple[str, str] = ("p1", "p2")
         "tests": {k: [float(v) for v in vals] for k, vals in curve.tests.items()},
         "stopped": list(curve.stopped),
         "start": int(curve.start),
+        **({} if curve.kappa is None else {"kappa": [float(v) for v in curve.kappa]}),
         "points": [
             {
                 "kind": pt.kind, n1: pt.p1, n2: pt.p2, "state": [float(v) for v in pt.y],
                 "multipliers": _pairs(pt.multipliers), "test": pt.test, "bracket": list(pt.bracket),
-                "converged": pt.converged,
+                "converged": pt.converged, **({} if pt.kappa is None else {"kappa": pt.kappa}),
             }
             for pt in curve.points
         ],
