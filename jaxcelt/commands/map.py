@@ -5,6 +5,12 @@ labels, optional largest Lyapunov exponent). Interrupting and rerunning the same
 from the finished chunks. Example (the paper's forcing plane)::
 
     jaxcelt map --x omega_pi=10:20:100 --y q_pi=0.02:0.06:60 --out out/map
+
+``--curves FILE`` draws bifurcation curves over both panels of the figure: a JSON result file with curves in the
+map's two parameters as `jaxcelt.orbits.curves.curve_to_dict` writes them (e.g. docs/orbits/curves_omega_q.json
+from scripts/curves_omega_q.py, docs/orbits/fold_curves.json). The curves are read, not computed: a curve takes
+minutes of variational solves per point and needs a start on a located one-parameter bifurcation, which is the
+curves script's job; the map command only draws them.
 """
 
 from __future__ import annotations
@@ -46,6 +52,8 @@ def register(sub) -> None:
     )
     p.add_argument("--out", type=Path, default=Path("out/map"), help="output directory (resumable)")
     p.add_argument("--no-figures", action="store_true")
+    p.add_argument("--curves", type=Path, default=None, metavar="FILE",
+                   help="JSON file of bifurcation curves in the map's two parameters, drawn over both panels")  # fmt: skip
     p.set_defaults(func=run)
 
 
@@ -61,6 +69,23 @@ def parse_axis(spec: str, flag: str):
     if values.size == 0:
         raise UsageError(f"argument {flag}: no values in {rng!r}")
     return name, values
+
+
+def read_curves(path: Path, x_name: str, y_name: str) -> dict:
+    """The curves file of ``--curves``, checked to hold curves in the map's parameters; `UsageError` otherwise."""
+    from jaxcelt.plotting.map import map_curve_lines
+
+    try:
+        data = json.loads(Path(path).read_text())
+    except OSError as e:
+        raise UsageError(f"argument --curves: cannot read {str(path)!r}: {e.strerror or e}") from None
+    except json.JSONDecodeError as e:
+        raise UsageError(f"argument --curves: {str(path)!r} is not JSON ({e.msg}, line {e.lineno})") from None
+    try:
+        map_curve_lines(data, x_name, y_name)
+    except (ValueError, KeyError, TypeError) as e:
+        raise UsageError(f"argument --curves: {str(path)!r}: {e}") from None
+    return data
 
 
 def summarize(ds) -> dict:
@@ -111,6 +136,7 @@ def run(args) -> int:
     for name, values in (x, y):  # each lane's parameters must be valid too
         for v in values:
             params.replace(**{name: float(v)})
+    curves = None if args.curves is None else read_curves(args.curves, x[0], y[0])
     y0 = np.asarray(jc.initial_state(params, omega=args.omega0))
     print(versions_string(), flush=True)
     load = os.getloadavg() if hasattr(os, "getloadavg") else None
@@ -131,6 +157,7 @@ def run(args) -> int:
         "x": {"name": x[0], "from": float(x[1][0]), "to": float(x[1][-1]), "n": int(x[1].size)},
         "y": {"name": y[0], "from": float(y[1][0]), "to": float(y[1][-1]), "n": int(y[1].size)},
         "set": args.set,
+        "curves": None if args.curves is None else str(args.curves),
         **run_settings(args, wall, devices),
         "dtype": args.dtype,
         "engine": args.engine,
@@ -147,7 +174,8 @@ def run(args) -> int:
 
         from jaxcelt.plotting.map import map_figure
 
-        fig = map_figure(ds, title=f"{x[0]} x {y[0]} map: {args.transient} transient + {args.sample} sampled periods")
+        title = f"{x[0]} x {y[0]} map: {args.transient} transient + {args.sample} sampled periods"
+        fig = map_figure(ds, title=title, curves=curves)
         fig.savefig(args.out / "map.png", dpi=150)
         plt.close(fig)
     print(f"wrote {args.out}", flush=True)

@@ -1,5 +1,11 @@
 """Two-parameter maps (`jaxcelt.parameter_map`): local regime and largest Lyapunov exponent over
-a grid of two parameters, side by side."""
+a grid of two parameters, side by side, optionally with bifurcation curves drawn over both panels.
+
+Curves come from a result dict as `jaxcelt.orbits.curves.curve_to_dict` writes them (one curve: its two
+parameters under their names, ``"kind"``, optionally ``"kappa"`` and ``"points"``) or a dict with such curves under
+``"curves"`` (each either a curve dict or a record with the curve under ``"curve"``, as
+``scripts/curves_omega_q.py`` and ``scripts/fold_curves.py`` write); `map_curve_lines` picks those in the map's two
+parameters."""
 
 from __future__ import annotations
 
@@ -8,7 +14,7 @@ import numpy as np
 from jaxcelt.plotting.bifurcation import REGIME_COLOURS
 from jaxcelt.sweeps.regimes import REGIMES
 
-__all__ = ["map_figure", "map_categories", "PARAM_LABELS"]
+__all__ = ["map_figure", "map_categories", "map_curve_lines", "draw_map_curves", "PARAM_LABELS", "CURVE_STYLES"]
 
 PARAM_LABELS = {
     "omega_pi": r"forcing frequency $\omega_\pi$ [rad/s]",
@@ -21,6 +27,13 @@ PARAM_LABELS = {
     "eps": r"friction smoothing $\varepsilon$ [s$^{-2}$]",
     "eps_R": r"rolling smoothing $\varepsilon_R$ [s$^{-2}$]",
 }
+
+CURVE_STYLES = {
+    "fold": ("black", "-"),
+    "period-doubling": ("#1b7837", "-."),
+    "neimark-sacker": ("#d95f02", "--"),
+}
+"""curve kind -> (colour, line style) of its line over a map"""
 
 # (label, colour) in legend order; periodic lanes split by their period
 _CATEGORIES = (
@@ -59,11 +72,13 @@ def _edges(v: np.ndarray) -> np.ndarray:
     return np.concatenate([[v[0] - (mid[0] - v[0])], mid, [v[-1] + (v[-1] - mid[-1])]])
 
 
-def map_figure(ds, *, title: str | None = None):
+def map_figure(ds, *, title: str | None = None, curves: dict | None = None):
     """Figure with two panels over the map's grid (x horizontal, y vertical): the local regime
     (categorical, legend; dots mark unbounded wandering of the centre O) and the largest
     Lyapunov exponent lambda_1 [1/s] (diverging colour scale centred on 0, colour bar; grey:
-    no exponent -- invalid, failed or not computed). Multi-start maps show the first start."""
+    no exponent -- invalid, failed or not computed). Multi-start maps show the first start.
+    ``curves``: bifurcation curves drawn over both panels (`draw_map_curves`; a ValueError naming ``curves``
+    if none lies in the map's two parameters)."""
     import matplotlib.pyplot as plt
     from matplotlib.colors import BoundaryNorm, ListedColormap, TwoSlopeNorm
     from matplotlib.lines import Line2D
@@ -108,6 +123,59 @@ def map_figure(ds, *, title: str | None = None):
         a.set_ylabel(PARAM_LABELS.get(yn, yn))
         a.set_xlim(X[0], X[-1])
         a.set_ylim(Y[0], Y[-1])
+    if curves is not None:
+        lines = map_curve_lines(curves, xn, yn)
+        for a in (a1, a2):
+            draw_map_curves(a, lines, legend=a is a2)
     if title:
         fig.suptitle(title, fontsize=12)
     return fig
+
+
+def map_curve_lines(data: dict, x_name: str, y_name: str) -> list[dict]:
+    """The curves of ``data`` in the map's parameters: one dict per curve with ``key``, ``kind``, ``x``, ``y``
+    (arrays), ``ns`` (bool array: a Neimark-Sacker point, |kappa| <= 1; True on other kinds) and ``points``
+    (located codimension-two points: (kind, x, y)). ValueError naming ``curves`` if ``data`` has none in
+    (``x_name``, ``y_name``)."""
+    if not isinstance(data, dict):
+        raise ValueError(f"curves: expected a JSON object, got {type(data).__name__}")
+    items = data["curves"].items() if isinstance(data.get("curves"), dict) else [("curve", data)]
+    out = []
+    for key, rec in items:
+        c = rec.get("curve", rec) if isinstance(rec, dict) else None
+        if not isinstance(c, dict) or x_name not in c or y_name not in c:
+            continue
+        x, y = np.asarray(c[x_name], dtype=float), np.asarray(c[y_name], dtype=float)
+        if x.shape != y.shape or x.ndim != 1:
+            raise ValueError(f"curves: curve {key!r} has {x_name} and {y_name} of different lengths")
+        kappa = np.asarray(c["kappa"], dtype=float) if "kappa" in c else np.zeros_like(x)
+        points = [(p["kind"], float(p[x_name]), float(p[y_name])) for p in c.get("points", [])]
+        out.append(dict(key=str(key), kind=str(c.get("kind", "")), x=x, y=y, ns=np.abs(kappa) <= 1.0, points=points))
+    if not out:
+        raise ValueError(f"curves: no curve in the map's parameters ({x_name}, {y_name})")
+    return out
+
+
+_POINT_MARKERS = {"1:1": "s", "1:2": "D", "1:3": "^", "1:4": "v", "cusp": "P", "fold-flip": "X"}
+
+
+def draw_map_curves(ax, lines: list[dict], *, legend: bool = True) -> None:
+    """Draw `map_curve_lines`' curves on ``ax``: one line style per kind (`CURVE_STYLES`); the neutral-saddle
+    stretches of a Neimark-Sacker curve (|kappa| > 1, not a bifurcation) thin and dotted; located codimension-two
+    points as markers; one legend entry per kind (and point kind) when ``legend``."""
+    from matplotlib.lines import Line2D
+
+    seen: dict[str, Line2D] = {}
+    for ln in lines:
+        colour, style = CURVE_STYLES.get(ln["kind"], ("0.2", ":"))
+        x, y, ns = ln["x"], ln["y"], ln["ns"]
+        ax.plot(x, np.where(ns, y, np.nan), color=colour, ls=style, lw=2.0)
+        if not np.all(ns):
+            ax.plot(x, y, color=colour, ls=":", lw=0.8)
+        seen.setdefault(ln["kind"], Line2D([], [], color=colour, ls=style, lw=2.0, label=f"{ln['kind']} curve"))
+        for kind, px, py in ln["points"]:
+            m = next((v for k, v in _POINT_MARKERS.items() if kind.startswith(k)), "o")
+            ax.plot(px, py, marker=m, color=colour, mec="white", ms=7, ls="")
+            seen.setdefault(kind, Line2D([], [], marker=m, color=colour, mec="white", ls="", label=kind))
+    if legend and seen:
+        ax.legend(handles=list(seen.values()), loc="lower right", fontsize=8, framealpha=0.85)
