@@ -10,6 +10,7 @@ Known answers:
   measured: all agree);
 * the Floquet multipliers of those orbits: a complex pair, so |mu|^2 = det M = exp(-delta T) (Liouville,
   the divergence of the field is -delta): |mu| = exp(-0.25 pi) to 1e-7 (Newton at rtol 1e-11);
+* the orbits are continued from value to value (each attractor's ``orbit_period`` 1 with its own multipliers);
 * the continuation's lanes equal `jaxcelt.sweeps.api.sweep` lanes at the same parameters and starts
   (tolerance 1e-8 (1 + |x|): two compiled programs of the same steps, measured ~1e-12);
 * resume: a run stopped after k values and resumed gives the same dataset, without recomputing the
@@ -19,6 +20,8 @@ Known answers:
 from __future__ import annotations
 
 import dataclasses
+import importlib.util
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -26,45 +29,25 @@ import pytest
 import jaxcelt as jc
 from jaxcelt.sweeps.continuation_core import continuation_summary, continue_section_attractors
 from jaxcelt.sweeps.continuation_match import cycle_distance, group_lanes, match_attractors, set_distance
-from jaxcelt.sweeps.continuation_ode import forced_ode_model
 from jaxcelt.sweeps.dataset import DamagedChunkWarning
 
-DELTA, T = 0.25, 2 * np.pi
+
+def _script():
+    """The Duffing problem and the scipy census, defined once in scripts/attractor_continuation.py (which writes
+    the committed result)."""
+    spec = importlib.util.spec_from_file_location(
+        "attractor_continuation", Path(__file__).resolve().parents[1] / "scripts" / "attractor_continuation.py"
+    )
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+S = _script()
+DELTA, T = S.DELTA, S.T_DUFFING
+duffing_model, grid_starts, scipy_wells = S.duffing_model, S.grid_starts, S.scipy_wells
 F_VALUES = [0.1, 0.15, 0.2]
 SETTINGS = dict(transient_periods=100, sample_periods=8)
-
-
-def duffing(t, y, a):
-    import jax.numpy as jnp
-
-    delta, F = a
-    return jnp.stack([y[1], -delta * y[1] + y[0] - y[0] ** 3 + F * jnp.cos(t)])
-
-
-def duffing_model(**kw):
-    return forced_ode_model(duffing, lambda F: (DELTA, F), lambda F: T, key="duffing delta=0.25 omega=1", **kw)
-
-
-def grid_starts(n: int) -> np.ndarray:
-    xs = np.linspace(-2.0, 2.0, n)
-    X, V = np.meshgrid(xs, xs, indexing="ij")
-    return np.stack([X.ravel(), V.ravel()], axis=1)
-
-
-def scipy_wells(F: float, starts: np.ndarray, periods: int) -> np.ndarray:
-    """x of the final section point of every start, by scipy alone (all starts as one vectorised system)."""
-    from scipy.integrate import solve_ivp
-
-    n = len(starts)
-
-    def rhs(t, Y):
-        x, v = Y[:n], Y[n:]
-        return np.concatenate([v, -DELTA * v + x - x**3 + F * np.cos(t)])
-
-    s = solve_ivp(rhs, (0.0, periods * T), np.concatenate([starts[:, 0], starts[:, 1]]), method="DOP853",
-                  rtol=1e-10, atol=1e-12, t_eval=[periods * T])  # fmt: skip
-    assert s.success
-    return s.y[:n, -1]
 
 
 @pytest.fixture(scope="module")
@@ -102,6 +85,9 @@ def test_duffing_multipliers_and_ids(duffing_run):
     assert np.all(ds["period"].values == 1) and np.all(ds["stable"].values == 1)
     assert np.all(ds["refine_status"].values == "converged")
     np.testing.assert_allclose(ds["multiplier_max"].values, np.exp(-DELTA * T / 2), rtol=0, atol=1e-7)
+    # the orbit that goes with each attractor is its own refined orbit here
+    assert np.all(ds["orbit_period"].values == 1)
+    np.testing.assert_array_equal(ds["orbit_multiplier_max"].values, ds["multiplier_max"].values)
     # each id stays in its well as F grows (matching by section distance)
     x = ds["section_point"].values[:, :, 0]
     assert np.all(np.sign(x) == np.sign(x[:, :1]))
@@ -222,19 +208,14 @@ def test_bad_input_names_the_parameter(call, match):
 
 @pytest.mark.slow
 def test_duffing_bigger_census_and_chaos():
-    """10 x 10 starts, F = 0.1 .. 0.25 against scipy (as above), then F = 0.3 (a chaotic attractor: one
-    non-periodic set, every start on it)."""
-    starts = grid_starts(10)
-    vals = [0.1, 0.15, 0.2, 0.25, 0.3]
-    kw = dict(transient_periods=150, sample_periods=16)
-    ds = continue_section_attractors(duffing_model(), "F", vals, starts, **kw)
-    for j, F in enumerate(vals[:4]):
-        x_scipy = scipy_wells(F, starts, kw["transient_periods"] + kw["sample_periods"] - 1)
-        present = np.flatnonzero(ds["exists"].values[:, j])
-        left = [a for a in present if ds["section_point"].values[a, j, 0] < 0][0]
-        f, s = ds["fraction"].values[left, j], ds["fraction_stderr"].values[left, j]
-        assert abs(f - np.mean(x_scipy < 0)) <= 3 * s
-        assert np.mean((ds["outcome"].values[j] == left) == (x_scipy < 0)) >= 0.95
+    """The committed check (10 x 10 starts, F = 0.1 .. 0.25, `duffing_check`) against scipy as above, then
+    F = 0.3 (a chaotic attractor: one non-periodic set, every start on it)."""
+    d = S.duffing_check()
+    for r in d["values"]:
+        assert [a["period"] for a in r["attractors"]] == [1, 1]
+        assert r["diff_over_sigma"] <= 3 and r["lane_agreement"] >= 0.95
+    ds = continue_section_attractors(duffing_model(), "F", [0.25, 0.3], grid_starts(10), refine=False,
+                                     transient_periods=150, sample_periods=16)  # fmt: skip
     last = np.flatnonzero(ds["exists"].values[:, -1])
     assert len(last) == 1 and ds["kind"].values[last[0], -1] == "aperiodic"
     assert ds["fraction"].values[last[0], -1] == 1.0

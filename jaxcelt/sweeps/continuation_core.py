@@ -35,6 +35,7 @@ import numpy as np
 from jaxcelt.sweeps.continuation_match import (
     KINDS,
     OUTCOMES,
+    _same_set,
     attractor_distance,
     group_lanes,
     lane_kinds,
@@ -117,6 +118,9 @@ def _seeds(prev: ValueRecord | None, per: int, dim: int) -> tuple[np.ndarray, np
                 else pts[:0]
             )
         chosen = np.concatenate([prev.att_state[a][None], extra])[:per]
+        orbit = prev.att_orbit_state[a]
+        if np.all(np.isfinite(orbit)) and not np.allclose(orbit, prev.att_state[a]):
+            chosen = np.concatenate([orbit[None], chosen])[:per]  # the orbit continued to this attractor
         chosen = chosen[np.all(np.isfinite(chosen), axis=1)]
         seeds.append(chosen)
         origin += [int(prev.att_id[a])] * len(chosen)
@@ -152,7 +156,7 @@ def _one_value(model, o, index, value, starts, seeds, origin, prev, next_id) -> 
     label, groups = group_lanes(kind, period, C, group_tol=o.group_tol, set_factor=o.set_factor)
     A, S = len(groups), samples.shape[1]
     rows: dict[str, list] = {k: [] for k in ("kind", "k", "count", "lanes", "state", "t", "cloud", "n", "refine",
-                                             "mu", "stable", "lyap", "lse")}  # fmt: skip
+                                             "mu", "stable", "lyap", "lse", "ostate")}  # fmt: skip
     for g, (kc, k, rep) in enumerate(groups):
         members = np.flatnonzero(label == g)
         fresh = members[members < N]
@@ -167,16 +171,28 @@ def _one_value(model, o, index, value, starts, seeds, origin, prev, next_id) -> 
         lv = ly[members] if ly is not None else np.zeros(0)
         sv = lse[members] if lse is not None else np.zeros(0)
         lv, sv = lv[np.isfinite(lv)], sv[np.isfinite(sv)]
+        ostate = state if ref[0] == 0 and ref[1] is not None else np.full(d, np.nan)
         for key, v in zip(rows, (kc, k, fresh.size, members.size, state, t, np.pad(cloud, ((0, S - len(cloud)), (0, 0)),
                                constant_values=np.nan), len(cloud), ref[0], ref[2], ref[3],
-                               np.median(lv) if lv.size else np.nan, np.median(sv) if sv.size else np.nan)):  # fmt: skip
+                               np.median(lv) if lv.size else np.nan, np.median(sv) if sv.size else np.nan,
+                               (ostate, k if ref[0] == 0 else 0, ref[2]))):  # fmt: skip
             rows[key].append(v)
-    # match to the previous value's attractors
+    # the previous value's periodic orbits continued to this value by Newton (a tie-breaker of the matching)
+    cont: dict[int, tuple] = {}
+    if prev is not None and o.refine and model.refine is not None:
+        t_new = float(np.asarray(batch.t_samples)[0, -1])  # a section time at this value
+        for b in range(len(prev.att_id)):
+            if int(prev.att_orbit_k[b]) > 0 and np.all(np.isfinite(prev.att_orbit_state[b])):
+                code, y, mu, _ = _refine(
+                    model, float(value), prev.att_orbit_state[b], t_new, int(prev.att_orbit_k[b]), o
+                )
+                if code == 0 and y is not None:
+                    cont[b] = (y, int(prev.att_orbit_k[b]), mu)
     match = np.full(A, -1, np.int64)
     if prev is not None and len(prev.att_id) and A:
         B = len(prev.att_id)
         dist = np.full((A, B), np.inf)
-        share = np.zeros((A, B))
+        evidence = np.zeros((A, B))
         for a in range(A):
             ca = np.asarray(model.coords(rows["cloud"][a][: rows["n"][a]]), float)
             for b in range(B):
@@ -185,13 +201,18 @@ def _one_value(model, o, index, value, starts, seeds, origin, prev, next_id) -> 
                     rows["kind"][a], rows["k"][a], ca, int(prev.att_kind[b]), int(prev.att_k[b]), cb
                 )
                 from_b = origin == prev.att_id[b]
-                if from_b.any():
-                    share[a, b] = float(np.mean(label[N:][from_b] == a))
-        match = match_attractors(dist, share, match_tol=o.match_tol, tie_rtol=o.tie_rtol)
+                if from_b.any():  # share of b's seeds that landed on a
+                    evidence[a, b] = float(np.mean(label[N:][from_b] == a))
+                if b in cont:  # b's orbit, continued to this value, lies on a
+                    y = np.asarray(model.coords(cont[b][0][None]), float)
+                    evidence[a, b] += float(_same_set(y, ca, o.group_tol, o.set_factor))
+        match = match_attractors(dist, evidence, match_tol=o.match_tol, tie_rtol=o.tie_rtol)
     ids = np.empty(A, np.int64)
     for a in range(A):
         if match[a] >= 0:
             ids[a] = int(prev.att_id[match[a]])
+            if rows["ostate"][a][1] == 0 and int(match[a]) in cont:  # not periodic here: keep the continued orbit
+                rows["ostate"][a] = cont[int(match[a])]
         else:
             ids[a], next_id = next_id, next_id + 1
     glob = np.where(label >= 0, ids[np.maximum(label, 0)] if A else -3, label)
@@ -207,6 +228,9 @@ def _one_value(model, o, index, value, starts, seeds, origin, prev, next_id) -> 
         att_refine=np.asarray(rows["refine"], np.int64), att_mu_max=np.asarray(rows["mu"], float),
         att_stable=np.asarray(rows["stable"], np.int64), att_lyap=np.asarray(rows["lyap"], float),
         att_lyap_se=np.asarray(rows["lse"], float),
+        att_orbit_state=np.asarray([x[0] for x in rows["ostate"]], float).reshape(A, d),
+        att_orbit_k=np.asarray([x[1] for x in rows["ostate"]], np.int64),
+        att_orbit_mu=np.asarray([x[2] for x in rows["ostate"]], float),
     )  # fmt: skip
 
 
@@ -303,6 +327,7 @@ def continuation_summary(ds) -> dict[str, Any]:
                 id=int(a), kind=str(f("kind")), period=int(f("period")), fraction=float(f("fraction")),
                 fraction_stderr=float(f("fraction_stderr")), lanes=int(f("n_lanes")),
                 refine_status=str(f("refine_status")), multiplier_max=_num(f("multiplier_max")),
+                orbit_period=int(f("orbit_period")), orbit_multiplier_max=_num(f("orbit_multiplier_max")),
                 stable=None if int(f("stable")) < 0 else bool(f("stable")), lyapunov=_num(f("lyapunov")),
                 lyapunov_stderr=_num(f("lyapunov_stderr")), section_point=[_num(x) for x in f("section_point")],
             ))  # fmt: skip

@@ -35,12 +35,13 @@ _LANE = ("lane_outcome", "lane_kind", "lane_period", "lane_final")
 _SEED = ("seed_origin", "seed_outcome")
 _ATT = (
     "att_id", "att_kind", "att_k", "att_count", "att_lanes", "att_state", "att_t", "att_cloud", "att_cloud_n",
-    "att_refine", "att_mu_max", "att_stable", "att_lyap", "att_lyap_se",
+    "att_refine", "att_mu_max", "att_stable", "att_lyap", "att_lyap_se", "att_orbit_state", "att_orbit_k",
+    "att_orbit_mu",
 )  # fmt: skip
 _DIMS = {
     "lane_outcome": ("lane",), "lane_kind": ("lane",), "lane_period": ("lane",), "lane_final": ("lane", "dim"),
     "seed_origin": ("seed",), "seed_outcome": ("seed",),
-    "att_state": ("att", "dim"), "att_cloud": ("att", "point", "dim"),
+    "att_state": ("att", "dim"), "att_cloud": ("att", "point", "dim"), "att_orbit_state": ("att", "dim"),
 }  # fmt: skip
 
 
@@ -63,6 +64,9 @@ class ValueRecord:
         many; att_refine: `REFINE_STATUS` code; att_mu_max: largest Floquet multiplier modulus (NaN if not
         refined); att_stable: 1 / 0 / -1 unknown; att_lyap, att_lyap_se: median lambda_1 of its lanes and
         the median of their standard errors [1/s] (NaN if not computed).
+        att_orbit_state, att_orbit_k, att_orbit_mu: the periodic orbit that goes with the attractor (its own
+        refined orbit, or the orbit of its predecessor continued to this value by Newton), its period (0: none)
+        and largest multiplier modulus; the next value continues it and seeds from it.
     """
 
     index: int
@@ -89,6 +93,9 @@ class ValueRecord:
     att_stable: np.ndarray
     att_lyap: np.ndarray
     att_lyap_se: np.ndarray
+    att_orbit_state: np.ndarray
+    att_orbit_k: np.ndarray
+    att_orbit_mu: np.ndarray
 
     def cloud(self, a: int) -> np.ndarray:
         """Section points (n, d) of the a-th attractor of this value."""
