@@ -9,7 +9,9 @@
 * `runners`: `AbstractLaneRunner`, the interface of whatever runs a chunk off this process's devices;
 * `processes`: `HostProcesses`, lanes over single-device worker processes, one per CPU core;
 * `kernel`: the lane kernel, every lane of a chunk stepped inside one GPU kernel, one thread
-  per lane (Pallas, Triton backend), with the field re-expressed on lane blocks by `soa`;
+  per lane (Pallas, Triton backend), with the field re-expressed on lane blocks by `soa`; its
+  stiffness switch in `stiff` (with the Rodas4P step of `rosenbrock`), and `kernel_ode`'s
+  `solve_lanes`, the kernel for any ODE (final states);
 * `config`: `SweepConfig`, the settings of a stroboscopic chunk, and the engines (`ENGINES`);
 * `stroboscopic`: `run_lanes`, one chunk of lanes sampled at the forcing's section times,
   sharded over devices, through the pool or the kernel (`ENGINES`), with the optional Lyapunov
@@ -25,6 +27,7 @@ from jaxcelt.ensemble.config import SweepConfig as SweepConfig
 from jaxcelt.ensemble.config import check_engine as check_engine
 from jaxcelt.ensemble.kernel import BLOCK as BLOCK
 from jaxcelt.ensemble.kernel import kernel_supported as kernel_supported
+from jaxcelt.ensemble.kernel_ode import solve_lanes as solve_lanes
 from jaxcelt.ensemble.lanes import LaneMonitor as LaneMonitor
 from jaxcelt.ensemble.lanes import LaneOutputs as LaneOutputs
 from jaxcelt.ensemble.lanes import LaneState as LaneState

@@ -24,6 +24,12 @@ to the integration tolerance, not bitwise, and may differ by a few steps
 (``tests/test_kernel.py``). Only explicit FSAL tableaux with an error estimate (Tsit5, the
 default; Dopri5; Dopri8) run here, and no Lyapunov stage (that stays a diffrax solve).
 
+Options (`jaxcelt.ensemble.SweepConfig`): ``field_dtype="float32"`` evaluates the field in float32
+while the state, the stage sums and the error control stay float64 (mixed precision);
+``stiffness="auto"`` lets each lane switch to a Rodas4P step while its explicit steps are
+stability-limited (`jaxcelt.ensemble.stiff`). The step, the controller and the loop do not depend
+on the wobblestone: `jaxcelt.ensemble.kernel_ode.solve_lanes` runs them for any per-lane field.
+
 Off a GPU the same kernel runs in Pallas' interpreter (``interpret=True``): slow, for tests.
 """
 
@@ -39,13 +45,22 @@ import numpy as np
 
 from jaxcelt._types import Array
 from jaxcelt.ensemble.soa import blockwise
-from jaxcelt.ensemble.stiff import step_either
 from jaxcelt.ensemble.stepper import erk_tableau
+from jaxcelt.ensemble.stiff import step_either
 from jaxcelt.integrate.solve import MIN_STEP_ULPS
 from jaxcelt.physics.contact.registry import get_contact_law
 from jaxcelt.physics.model import field_time, vector_field_and_normal
 
-__all__ = ["BLOCK", "kernel_supported", "make_segment", "run_kernel_lanes", "KERNEL_FIELDS"]
+__all__ = [
+    "BLOCK",
+    "KERNEL_FIELDS",
+    "Segment",
+    "flatten_state",
+    "kernel_supported",
+    "make_segment",
+    "run_kernel_lanes",
+    "unflatten_state",
+]
 
 BLOCK = 32
 """lanes per kernel program: one warp, one lane per thread"""
@@ -85,7 +100,7 @@ def _triton_params() -> Any:
     return plt.CompilerParams(num_warps=1, num_stages=1)
 
 
-class _Segment:
+class Segment:
     """The kernel of one call: every lane of a block to its target time (module docstring).
 
     ``field``: a per-lane function ``(t, y, pv) -> (dy/dt, (N, den))`` of the state's dtype, with
@@ -285,7 +300,7 @@ class _Segment:
         ins = refs[: nst + 3 + self.nvary]
         outs = refs[nst + 3 + self.nvary :]
         vals = [r[...] for r in ins]
-        s = _unflatten(vals[:nst], self.n)
+        s = unflatten_state(vals[:nst], self.n)
         target, t1, floor = vals[nst : nst + 3]
         pv = tuple(vals[nst + 3 :])
         s["tnext"] = jnp.where(s["tprev"] < target, jnp.minimum(s["tnext"], target), s["tnext"])
@@ -300,7 +315,7 @@ class _Segment:
             return s, it + 1, jnp.max(act.astype(jnp.int32)) > 0
 
         s, it, _ = jax.lax.while_loop(cond, body, (s, jnp.zeros((), jnp.int32), jnp.asarray(True)))
-        for r, v in zip(outs, _flatten(s) + [jnp.full(target.shape, it, jnp.int32)]):
+        for r, v in zip(outs, flatten_state(s) + [jnp.full(target.shape, it, jnp.int32)]):
             r[...] = v
 
     def __call__(self, flat: list[Array], target: Array, t1: Array, floor: Array, pv: tuple[Array, ...],
@@ -318,24 +333,26 @@ class _Segment:
         return list(out[:-1]), out[-1]
 
 
-def make_segment(cfg: Any, params_of: Any, nvary: int) -> _Segment:
+def make_segment(cfg: Any, params_of: Any, nvary: int) -> Segment:
     """The kernel for a sweep's settings ``cfg`` (`jaxcelt.ensemble.SweepConfig`); ``params_of``
     rebuilds a lane's parameters from its ``nvary`` varying values (the others plain numbers)."""
-    return _Segment(cfg, params_of, nvary, cfg.dtype)
+    return Segment(cfg, params_of, nvary, cfg.dtype)
 
 
-def _flatten(s: dict) -> list[Array]:
+def flatten_state(s: dict) -> list[Array]:
+    """The kernel's per-lane state as the list of (L,) arrays its call takes: y, f, then `KERNEL_FIELDS`."""
     return list(s["y"]) + list(s["f"]) + [s[k] for k in KERNEL_FIELDS]
 
 
-def _unflatten(v: list[Array], n: int) -> dict:
+def unflatten_state(v: list[Array], n: int) -> dict:
+    """The inverse of `flatten_state` for a state of size ``n``."""
     s = dict(y=list(v[:n]), f=list(v[n : 2 * n]))
     s.update(zip(KERNEL_FIELDS, v[2 * n :]))
     return s
 
 
 def run_kernel_lanes(
-    seg: _Segment,
+    seg: Segment,
     lanes0: Any,
     pv: tuple[Array, ...],
     ts_all: Array,
@@ -379,9 +396,9 @@ def run_kernel_lanes(
         sample = jnp.where((flat[26] >= target)[:, None], y, jnp.inf)
         return (flat, iters + it), sample
 
-    flat = _flatten(s)
+    flat = flatten_state(s)
     (flat, iters), samples = jax.lax.scan(section, (flat, jnp.zeros((L,), jnp.int32)), ts_all.T)
-    s = _unflatten(flat, 13)
+    s = unflatten_state(flat, 13)
     samples = jnp.swapaxes(samples, 0, 1).astype(dt_)
     ok = s["code"] == 0
     num_steps = jnp.where(parked, lanes0.num_steps, s["num_steps"])

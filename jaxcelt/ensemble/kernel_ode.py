@@ -25,7 +25,7 @@ import numpy as np
 
 from jaxcelt._diffrax_adapter import t1_clip_floor
 from jaxcelt._types import Array
-from jaxcelt.ensemble.kernel import BLOCK, KERNEL_FIELDS, _Segment, _flatten, _unflatten, kernel_supported
+from jaxcelt.ensemble.kernel import BLOCK, KERNEL_FIELDS, Segment, flatten_state, kernel_supported, unflatten_state
 
 __all__ = ["solve_lanes"]
 
@@ -82,7 +82,7 @@ def solve_lanes(
     y0, args = pad(y0), tuple(pad(a) for a in args)
     cfg = types.SimpleNamespace(solver=solver, rtol=rtol, atol=atol, max_steps=max_steps, stop_on_invalid=False,
                                 contact_law=None, stiffness="off")  # fmt: skip
-    seg = _Segment(cfg, None, len(args), dtype, field=lambda t, y, pv: (field(t, y, pv), (1.0, 1.0)), n=n,
+    seg = Segment(cfg, None, len(args), dtype, field=lambda t, y, pv: (field(t, y, pv), (1.0, 1.0)), n=n,
                    omega_of=None, n3_index=None)  # fmt: skip
     t0a = jnp.full((Lp,), t0, jnp.float64)
     t1a = jnp.full((Lp,), t1, jnp.float64)
@@ -97,8 +97,8 @@ def solve_lanes(
              first_invalid_t=jnp.full((Lp,), jnp.inf, jnp.float64), min_N=jnp.full((Lp,), jnp.inf, dtype),
              min_n3=jnp.full((Lp,), jnp.inf, dtype))  # fmt: skip
     floor = jax.vmap(t1_clip_floor)(t1a)
-    flat, _ = seg(_flatten(s), t1a, t1a, floor, args, interpret)
-    s = _unflatten(flat, n)
+    flat, _ = seg(flatten_state(s), t1a, t1a, floor, args, interpret)
+    s = unflatten_state(flat, n)
     done = s["tprev"] >= t1a
     status = jnp.where(s["code"] != 0, s["code"], jnp.where(done, 0, 1)).astype(jnp.int32)
     return dict(y1=jnp.stack(s["y"], axis=-1)[:L], status=status[:L], num_steps=s["num_steps"][:L])
