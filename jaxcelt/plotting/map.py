@@ -31,7 +31,7 @@ PARAM_LABELS = {
 CURVE_STYLES = {
     "fold": ("black", "-"),
     "period-doubling": ("#1b7837", "-."),
-    "neimark-sacker": ("#d95f02", "--"),
+    "neimark-sacker": ("#7b3294", "--"),
 }
 """curve kind -> (colour, line style) of its line over a map"""
 
@@ -156,6 +156,8 @@ def map_curve_lines(data: dict, x_name: str, y_name: str) -> list[dict]:
     return out
 
 
+_CURVE_LABELS = {"fold": "fold curve", "period-doubling": "period-doubling curve",
+                 "neimark-sacker": "Neimark-Sacker (torus) curve"}  # fmt: skip
 _POINT_MARKERS = {"1:1": "s", "1:2": "D", "1:3": "^", "1:4": "v", "cusp": "P", "fold-flip": "X"}
 
 
@@ -163,16 +165,19 @@ def draw_map_curves(ax, lines: list[dict], *, legend: bool = True) -> None:
     """Draw `map_curve_lines`' curves on ``ax``: one line style per kind (`CURVE_STYLES`); the neutral-saddle
     stretches of a Neimark-Sacker curve (|kappa| > 1, not a bifurcation) thin and dotted; located codimension-two
     points as markers; one legend entry per kind (and point kind) when ``legend``."""
+    from matplotlib import patheffects
     from matplotlib.lines import Line2D
 
+    halo = [patheffects.withStroke(linewidth=4.5, foreground="white", alpha=0.9)]
     seen: dict[str, Line2D] = {}
     for ln in lines:
         colour, style = CURVE_STYLES.get(ln["kind"], ("0.2", ":"))
         x, y, ns = ln["x"], ln["y"], ln["ns"]
-        ax.plot(x, np.where(ns, y, np.nan), color=colour, ls=style, lw=2.0)
+        ax.plot(x, np.where(ns, y, np.nan), color=colour, ls=style, lw=2.2, path_effects=halo)
         if not np.all(ns):
             ax.plot(x, y, color=colour, ls=":", lw=0.8)
-        seen.setdefault(ln["kind"], Line2D([], [], color=colour, ls=style, lw=2.0, label=f"{ln['kind']} curve"))
+        label = _CURVE_LABELS.get(ln["kind"], f"{ln['kind']} curve")
+        seen.setdefault(ln["kind"], Line2D([], [], color=colour, ls=style, lw=2.0, label=label))
         for kind, px, py in ln["points"]:
             m = next((v for k, v in _POINT_MARKERS.items() if kind.startswith(k)), "o")
             ax.plot(px, py, marker=m, color=colour, mec="white", ms=7, ls="")
