@@ -255,6 +255,10 @@ def plot(d: dict, path: Path) -> None:
                 y = np.asarray(a[key])
                 big = a["kind"] == "periodic"
                 filled = big and a.get("stable") is True
+                if not big and a.get("orbit_period"):  # the orbit continued by Newton, on a non-periodic attractor
+                    c = a["orbit_point"][4] if key == "omega2_points" else np.degrees(a["orbit_point"][12]) % 360
+                    ax.scatter([r["value"]], [c], s=70, marker="x" if a["orbit_multiplier_max"] >= 1 else "+",
+                               color=colour[a["id"]], linewidths=1.8, zorder=4)  # fmt: skip
                 ax.scatter(
                     np.full(len(y), r["value"]), y, s=55 if big else 7, marker="D" if big else "o",
                     facecolors=colour[a["id"]] if (filled or not big) else "white", edgecolors=colour[a["id"]],
@@ -266,8 +270,8 @@ def plot(d: dict, path: Path) -> None:
     axes[2].set_yticks(range(0, 361, 90))
     axes[2].set_xlabel("forcing frequency ω_π [rad/s]")
     axes[1].set_title(
-        "section points: diamonds periodic (filled: stable by its Floquet multipliers), dots the samples of "
-        "non-periodic attractors; colours as above",
+        "section points: diamonds periodic attractors (filled: stable by their Floquet multipliers), dots the samples "
+        "of non-periodic ones; + / ×: their periodic orbit continued by Newton, stable / unstable",
         fontsize=9,
     )
     fig.tight_layout()

@@ -328,6 +328,7 @@ def continuation_summary(ds) -> dict[str, Any]:
                 fraction_stderr=float(f("fraction_stderr")), lanes=int(f("n_lanes")),
                 refine_status=str(f("refine_status")), multiplier_max=_num(f("multiplier_max")),
                 orbit_period=int(f("orbit_period")), orbit_multiplier_max=_num(f("orbit_multiplier_max")),
+                orbit_point=[_num(x) for x in f("orbit_point")],
                 stable=None if int(f("stable")) < 0 else bool(f("stable")), lyapunov=_num(f("lyapunov")),
                 lyapunov_stderr=_num(f("lyapunov_stderr")), section_point=[_num(x) for x in f("section_point")],
             ))  # fmt: skip

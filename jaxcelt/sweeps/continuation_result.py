@@ -12,7 +12,7 @@ NaN / -1 elsewhere):
 * ``kind`` (`jaxcelt.sweeps.continuation_match.KINDS`), ``period`` (k; 0 unless periodic);
 * ``refine_status``, ``multiplier_max`` (largest |Floquet multiplier| of the refined orbit), ``stable``
   (1, 0, -1 unknown); ``lyapunov``, ``lyapunov_stderr`` [1/s] (median over its lanes, NaN if not computed);
-* ``orbit_period``, ``orbit_multiplier_max``: the periodic orbit that goes with the attractor -- its own
+* ``orbit_period``, ``orbit_multiplier_max``, ``orbit_point``: the periodic orbit that goes with the attractor -- its own
   refined orbit, or, for an attractor that is not periodic here, the orbit of its predecessor continued to
   this value by Newton (from one value to the next, as long as Newton converges). A stable orbit there
   (``orbit_multiplier_max`` < 1) on a non-periodic attractor says its lanes are still converging to it (weak
@@ -67,6 +67,7 @@ def continuation_dataset(records, *, name: str, starts: np.ndarray, model, optio
     ts = np.full((A, V), np.nan)
     ok = np.zeros((A, V), np.int64)
     omu = np.full((A, V), np.nan)
+    opt = np.full((A, V, d), np.nan)
     P = max((r.att_cloud.shape[1] for r in records), default=1)
     pts = np.full((A, V, P, d), np.nan)
     for j, r in enumerate(records):
@@ -81,7 +82,7 @@ def continuation_dataset(records, *, name: str, starts: np.ndarray, model, optio
             ly[gid, j], lse[gid, j] = r.att_lyap[a], r.att_lyap_se[a]
             st[gid, j], ts[gid, j] = r.att_state[a], r.att_t[a]
             pts[gid, j, : r.att_cloud.shape[1]] = r.att_cloud[a]
-            ok[gid, j], omu[gid, j] = r.att_orbit_k[a], r.att_orbit_mu[a]
+            ok[gid, j], omu[gid, j], opt[gid, j] = r.att_orbit_k[a], r.att_orbit_mu[a], r.att_orbit_state[a]
     tip = np.array([np.mean(r.lane_outcome == -1) for r in records])
     fail = np.array([np.mean(r.lane_outcome == -2) for r in records])
     vals = np.array([r.value for r in records])
@@ -109,6 +110,7 @@ def continuation_dataset(records, *, name: str, starts: np.ndarray, model, optio
         "orbit_period": var(AV, ok, "period k of the orbit that goes with it: its own refined orbit, or its "
                             "predecessor's continued here by Newton (0: none)"),
         "orbit_multiplier_max": var(AV, omu, "largest Floquet multiplier modulus of that orbit"),
+        "orbit_point": var((*AV, "state"), opt, "that orbit's section state", "SI"),
         "t_section": var(AV, ts, "time of the representative section state", "s"),
         "tipping_fraction": var((name,), tip, "fresh starts that left the model's validity (tipping over)"),
         "tipping_fraction_stderr": var((name,), np.sqrt(tip * (1 - tip) / N), "binomial standard error"),
