@@ -271,7 +271,8 @@ def plot(d: dict, path: Path) -> None:
     axes[2].set_xlabel("forcing frequency ω_π [rad/s]")
     axes[1].set_title(
         "section points: diamonds periodic attractors (filled: stable by their Floquet multipliers), dots the samples "
-        "of non-periodic ones; + / ×: their periodic orbit continued by Newton, stable / unstable",
+        "of non-periodic ones;\n+ / ×: the periodic orbit of a non-periodic attractor, continued by Newton, stable / "
+        "unstable",
         fontsize=9,
     )
     fig.tight_layout()
