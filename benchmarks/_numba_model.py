@@ -20,6 +20,8 @@ import numba as nb
 import numpy as np
 from scipy.special import ellipe, ellipk
 
+from jaxcelt.integrate.solve import HEADING_GAP  # one rule for both sides of the benchmark
+
 # indices into the packed parameter vector
 (A1, A2, A3, M, K1, K2, K3, GRAV, AH, BB, MU, KR, BR, S0, S2, S3, BTS, BMS, MTS, MMS, EPS, EPSR, QPI, WPI, KAPPA, VSIGN,
  DEX, KE, EE, GE, HE) = range(31)  # fmt: skip
@@ -169,7 +171,9 @@ def _dopri_lane(y0, t0, ts, P, B, Bi, rtol, atol, max_steps, out_ys, C, A, B5, E
     """Integrate one lane, stepping exactly onto each ts[j]; returns (steps, rhs_evals, status).
 
     ``stop_invalid``: end the lane (status 2) at the first accepted step whose end state has
-    N <= 0 (lift-off) or n3 <= 0, as ``jaxcelt``'s ``stop_on_invalid`` does. N comes free from
+    N <= 0 (lift-off) or n3 <= 0, as ``jaxcelt``'s ``stop_on_invalid`` does. Integrated on, a lane past
+    validity ends (status 4) where the stone lies on its side, 1 - n2^2 < ``HEADING_GAP``, as jaxcelt's
+    lanes do. N comes free from
     the FSAL derivative: the normal projection of m (v_dot + w x v) = -m g n + N (n + t) with
     t . n = 0 gives N = m ((v_dot + w x v) . n + g).
     """
@@ -191,6 +195,7 @@ def _dopri_lane(y0, t0, ts, P, B, Bi, rtol, atol, max_steps, out_ys, C, A, B5, E
     h = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     j = 0
     steps = 0
+    past = False  # the lane has left the model's validity (N <= 0 or n3 <= 0 at an accepted step)
     while j < ts.shape[0]:
         if steps >= max_steps:
             return steps, evals, 1
@@ -224,11 +229,14 @@ def _dopri_lane(y0, t0, ts, P, B, Bi, rtol, atol, max_steps, out_ys, C, A, B5, E
             if hit:
                 out_ys[j] = y
                 j += 1
-            if stop_invalid:
-                c0, c1, c2 = _cross(y[3], y[4], y[5], y[0], y[1], y[2])
-                N = P[M] * ((K[0, 0] + c0) * y[6] + (K[0, 1] + c1) * y[7] + (K[0, 2] + c2) * y[8] + P[GRAV])
-                if N <= 0.0 or y[8] <= 0.0:
+            c0, c1, c2 = _cross(y[3], y[4], y[5], y[0], y[1], y[2])
+            N = P[M] * ((K[0, 0] + c0) * y[6] + (K[0, 1] + c1) * y[7] + (K[0, 2] + c2) * y[8] + P[GRAV])
+            if N <= 0.0 or y[8] <= 0.0:
+                if stop_invalid:
                     return steps, evals, 2
+                past = True
+            if past and 1.0 - y[7] * y[7] < HEADING_GAP:
+                return steps, evals, 4  # on its side past validity (jaxcelt.integrate.solve.HEADING_GAP)
         fac = 10.0 if err == 0 else min(10.0, max(0.2, 0.9 * err ** (-1 / 5)))
         h = hh * fac
         if err > 1.0 and h < 10.0 * (np.nextafter(t, np.inf) - t):

@@ -47,7 +47,7 @@ from jaxcelt._types import Array
 from jaxcelt.ensemble.soa import blockwise
 from jaxcelt.ensemble.stepper import erk_tableau
 from jaxcelt.ensemble.stiff import step_either
-from jaxcelt.integrate.solve import MIN_STEP_ULPS
+from jaxcelt.integrate.solve import HEADING_GAP, MIN_STEP_ULPS
 from jaxcelt.physics.contact.registry import get_contact_law
 from jaxcelt.physics.model import field_time, vector_field_and_normal
 
@@ -68,7 +68,8 @@ BLOCK = 32
 KERNEL_FIELDS = ("tprev", "tnext", "num_steps", "code", "first_invalid_t", "first_invalid_kind", "min_N", "min_n3",
                  "stiff", "stiff_count", "stiff_steps")  # fmt: skip
 """per-lane scalars of the kernel's state besides y (n) and the FSAL derivative f (n). ``code``:
-0 running or done, 2 stopped at an invalid state, 3 step size collapsed (`jaxcelt.STATUS`);
+0 running or done, 2 stopped at an invalid state, 3 step size collapsed, 4 past validity at the heading's
+singularity (`jaxcelt.STATUS`);
 ``stiff``: 1 while the lane takes the stiff step (`jaxcelt.ensemble.stiff`), ``stiff_count`` its
 switch's counter, ``stiff_steps`` the stiff steps taken"""
 _INT = ("num_steps", "code", "first_invalid_kind", "stiff", "stiff_count", "stiff_steps")
@@ -274,6 +275,9 @@ class Segment:
         code = jnp.where(ctl["small"] & (s["code"] == 0), 3, s["code"])
         if self.stop_on_invalid:
             code = jnp.where(new_invalid & (code == 0), 2, code)
+        if self.n3_index is not None:  # past validity on its side: the heading's singularity (`HEADING_GAP`)
+            past = (s["first_invalid_kind"] > 0) | (kind > 0)
+            code = jnp.where(keep & past & (1 - y1[7] * y1[7] < HEADING_GAP) & (code == 0), 4, code)
         n3 = y1[self.n3_index] if self.n3_index is not None else s["min_n3"]
         new = dict(
             y=[jnp.where(keep, a, b) for a, b in zip(y1, y0)],

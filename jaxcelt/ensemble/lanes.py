@@ -59,6 +59,8 @@ class LaneMonitor(eqx.Module):
     """minimum normal force over accepted step ends [N]"""
     max_tilt: Array
     """maximum tilt arccos(n3) over accepted step ends [rad]"""
+    at_singularity: Array
+    """bool: the lane ended past validity at the heading's singularity (status 4)"""
 
 
 class LaneOutputs(eqx.Module):

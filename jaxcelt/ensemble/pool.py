@@ -138,7 +138,7 @@ def lane_outputs(stepper: AbstractLaneStepper, lanes: LaneState) -> LaneOutputs:
     mon = jax.vmap(stepper.monitor)(lanes)
     return LaneOutputs(
         y_final=lanes.y,
-        status=jax.vmap(lane_status)(lanes),
+        status=jnp.where(mon.at_singularity, 4, jax.vmap(lane_status)(lanes)).astype(jnp.int32),
         num_steps=lanes.num_steps,
         first_invalid_t=mon.first_invalid_t,
         first_invalid_kind=mon.first_invalid_kind.astype(jnp.int32),

@@ -39,6 +39,7 @@ from jaxcelt._diffrax_adapter import clip_to_end, loop_init, loop_step, t1_clip_
 from jaxcelt._types import Array
 from jaxcelt.ensemble.lanes import LaneMonitor, LaneState
 from jaxcelt.integrate.solve import (
+    HEADING_GAP,
     MinStepController,
     MonitoredSolver,
     _fill_implicit_tols,
@@ -80,6 +81,8 @@ class FusedStepState(eqx.Module):
     min_N: Array
     min_n3: Array
     """min n3 over accepted step ends (max tilt = arccos of it: arccos is decreasing)"""
+    at_singularity: Array
+    """bool: the lane ended past validity at the heading's singularity (`jaxcelt.integrate.solve.HEADING_GAP`)"""
 
 
 def _controller(tols: Array, ts: Array) -> MinStepController:
@@ -188,7 +191,7 @@ class DiffraxStepper(AbstractLaneStepper):
 
     def monitor(self, lane):
         mon = lane.step_state.solver_state[1]
-        return LaneMonitor(mon.first_invalid_t, mon.first_invalid_kind, mon.min_N, mon.max_tilt)
+        return LaneMonitor(mon.first_invalid_t, mon.first_invalid_kind, mon.min_N, mon.max_tilt, jnp.zeros((), bool))
 
 
 def _combine(y0: Array, coeffs: Any, ks: list[Array]) -> Array:
@@ -255,8 +258,9 @@ class FusedERKStepper(AbstractLaneStepper):
         f0, (N, den) = vector_field_and_normal(t0, y0, p, self.law)
         kind = invalid_kind(N, den, y0[8])
         state = FusedStepState(
-            f=f0, first_invalid_t=jnp.where(kind > 0, t0, jnp.inf), first_invalid_kind=kind, min_N=N, min_n3=y0[8]
-        )
+            f=f0, first_invalid_t=jnp.where(kind > 0, t0, jnp.inf), first_invalid_kind=kind, min_N=N, min_n3=y0[8],
+            at_singularity=jnp.zeros((), bool),
+        )  # fmt: skip
         return _start(t0, y0, ts, tols, tnext, state, kind, self.stop_on_invalid)
 
     def step(self, lane, p, ts):
@@ -305,6 +309,10 @@ class FusedERKStepper(AbstractLaneStepper):
         result = R.where(small & (lane.result == R.successful), R.dt_min_reached, lane.result)
         if self.stop_on_invalid:
             result = R.where(new_invalid & (result == R.successful), R.event_occurred, result)
+        # past validity, the stone lying on its side: the heading's singularity ends the lane (status 4)
+        past = (st.first_invalid_kind > 0) | (kind > 0)
+        singular = keep & past & (1 - y1[7] * y1[7] < HEADING_GAP) & (result == R.successful)
+        result = R.where(singular, R.event_occurred, result)
         num_steps = lane.num_steps + 1
         done = (result != R.successful) | (tprev >= t1) | (num_steps >= self.max_steps)
         state = FusedStepState(
@@ -313,6 +321,7 @@ class FusedERKStepper(AbstractLaneStepper):
             first_invalid_kind=jnp.where(new_invalid, kind, st.first_invalid_kind),
             min_N=jnp.where(keep, jnp.minimum(st.min_N, N), st.min_N),
             min_n3=jnp.where(keep, jnp.minimum(st.min_n3, y1[8]), st.min_n3),
+            at_singularity=st.at_singularity | singular,
         )
         new = LaneState(
             y=jnp.where(keep, y1, y0),
@@ -331,7 +340,9 @@ class FusedERKStepper(AbstractLaneStepper):
 
     def monitor(self, lane):
         st = lane.step_state
-        return LaneMonitor(st.first_invalid_t, st.first_invalid_kind, st.min_N, jnp.arccos(jnp.clip(st.min_n3, -1, 1)))
+        return LaneMonitor(
+            st.first_invalid_t, st.first_invalid_kind, st.min_N, jnp.arccos(jnp.clip(st.min_n3, -1, 1)), st.at_singularity
+        )
 
 
 def float64_times(lanes: LaneState, t1: Array) -> LaneState:

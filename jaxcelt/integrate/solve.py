@@ -39,7 +39,22 @@ INVALID_KINDS = {
     2: "contact off the lower half-surface (n3 <= 0)",
     3: "constraint denominator <= 0",
 }
-STATUS = {0: "success", 1: "max_steps reached", 2: "stopped at invalid state", 3: "solver failure"}
+STATUS = {
+    0: "success",
+    1: "max_steps reached",
+    2: "stopped at invalid state",
+    3: "solver failure",
+    4: "stopped past validity at the heading's singularity",
+}
+"""Status codes of a solve or a lane. 4 is given to lanes only (`jaxcelt.ensemble`): a lane integrated on past
+the model's validity ends where the stone lies on its side (`HEADING_GAP`)."""
+
+HEADING_GAP = 1e-6
+"""A lane integrated on past the model's validity (``stop_on_invalid=False``) ends, with status 4, at the first
+accepted step whose end has 1 - n2² below this: the stone lies within ~0.06° of its side (n3 ≈ 0, body x2
+vertical), where the heading rate (ω1 n1 + ω3 n3)/(1 - n2²) and the frame of the base's motion (MODEL.md)
+are singular. Without it such a lane rejects steps until its step size collapses (status 3) or its step
+budget is spent (status 1) (docs/bifurcation/max-steps.md)."""
 
 MIN_STEP_ULPS = 10
 """A rejected step that would shrink the step below this many ULPs of t (or make it NaN) ends the

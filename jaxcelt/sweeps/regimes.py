@@ -9,7 +9,8 @@ with psi determine the dynamics; r_C does not feed back):
 
 * ``failed``   -- the solve did not finish (status 1 or 3, e.g. max_steps);
 * ``invalid``  -- the model left its validity (lift-off, n3 <= 0) somewhere in the run, or the
-  lane was stopped there (status 2, ``stop_on_invalid``);
+  lane was stopped there (status 2, ``stop_on_invalid``), or, integrated on, it ended lying on its
+  side (status 4, `jaxcelt.integrate.solve.HEADING_GAP`);
 * ``period-k`` -- smallest k <= ``max_period`` with max_j |x_{j+k} - x_j| <= tol (1 + max|x|)
   over the samples; k = 1 is the forcing period (a period-1 orbit of the stroboscopic map);
 * otherwise, from the largest Lyapunov exponent lambda_1 and, where it comes with one, its
@@ -126,7 +127,7 @@ def classify(
     period = np.zeros(flat.shape[0], dtype=np.int32)
     glob = np.full(flat.shape[0], -1, dtype=np.int32)
     for i in range(flat.shape[0]):
-        if st[i] == 2:  # stopped at its first invalid state (stop_on_invalid)
+        if st[i] in (2, 4):  # stopped at its first invalid state (stop_on_invalid), or on its side past validity
             regime[i] = 1
             continue
         if st[i] != 0:
