@@ -59,7 +59,7 @@ def celt_section_model(params: CeltParams, name: str) -> SectionModel:
         r = sweep(params, name, [value], y0=yp, options=so)
         r = jax.tree_util.tree_map(lambda x: np.asarray(x)[:, :L], r)
         status, valid = np.asarray(r.status)[0], np.asarray(r.valid)[0]
-        outcome = np.where(status == 2, 1, np.where(status != 0, 2, np.where(valid, 0, 1)))
+        outcome = np.where(np.isin(status, (2, 4)), 1, np.where(status != 0, 2, np.where(valid, 0, 1)))  # 4: on its side
         have = o.lyapunov_periods > 0
         return LaneBatch(
             samples=np.asarray(r.samples)[0], t_samples=np.asarray(r.t_samples)[0], outcome=outcome,
