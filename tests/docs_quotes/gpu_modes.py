@@ -175,3 +175,18 @@ SETTINGS = [
     (BIF, "The 400 × 400 map's time stays set by its 760 sticking lanes"),
     (BIF, "Neither\n  reaches 98 % of the labels at twice the speed"),
 ]
+
+# the heading's singularity (status 4): the angle that HEADING_GAP = 1e-6 on 1 - n2^2 leaves, a consequence of the
+# setting (arcsin(sqrt(1e-6)) = 0.057°), checked here against the constant
+STATUS_PAGE = "docs/explanation/status-codes.md"
+
+
+def _gap_degrees() -> str:
+    import math
+
+    from jaxcelt.integrate.solve import HEADING_GAP
+
+    return f"{math.degrees(math.asin(math.sqrt(HEADING_GAP))):.2f}".rstrip("0")
+
+
+QUOTES += [(STATUS_PAGE, lambda: f"(on its side to within about {_gap_degrees()}°)")]
