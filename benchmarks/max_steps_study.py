@@ -15,6 +15,7 @@ lanes that are expensive for any of them. Steps per lane and statuses go to a JS
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import time
 from pathlib import Path
@@ -66,6 +67,8 @@ def main():
     ap.add_argument("--max-steps", type=int, default=10**6)
     ap.add_argument("--top", type=int, default=24, help="lanes re-run with jaxcelt: the costliest for numba DP5")
     ap.add_argument("--out", default=None)
+    ap.add_argument("--name", default="max_steps_study.json", help="result file name in --out")
+    ap.add_argument("--lanes-from", default=None, help="re-run the omega_pi values of this earlier result file")
     a = ap.parse_args()
     load0 = load_average()
     rtol, atol = 1e-8, 1e-10
@@ -84,6 +87,9 @@ def main():
     top = np.argsort(-st_dp)[: a.top]
     # lanes the numba loop ended on a non-finite state (status 3) are costly for diffrax too
     top = np.unique(np.r_[top, np.flatnonzero(status_dp == 3)])
+    if a.lanes_from:  # the same lanes as an earlier study (e.g. before a rule changed)
+        earlier = [r["omega_pi"] for r in json.loads(Path(a.lanes_from).read_text())["lanes"]]
+        top = np.array([int(np.argmin(np.abs(vals - w))) for w in earlier])
     st_ts, status_ts = numba_lanes(Y0[top], TS[top], PP[top], B, Bi, rtol, atol, a.max_steps, tsit5_tableau())
     lanes = {}
     for solver in ("Tsit5", "Dopri5"):
@@ -104,12 +110,15 @@ def main():
             }
         )
     res["lanes"] = rows
-    res["note"] = "each entry: [accepted+rejected steps, status] (0 ok, 1 max_steps, 3 non-finite error or collapsed step)"
+    res["note"] = (
+        "each entry: [accepted+rejected steps, status] (0 ok, 1 max_steps, 3 non-finite error or collapsed step, "
+        "4 past validity on its side: jaxcelt.integrate.solve.HEADING_GAP)"
+    )
     print(f"{'omega_pi':>9} {'nb DP5':>14} {'nb Tsit5':>14} {'jc Tsit5':>14} {'jc Dopri5':>14}")
     for r in rows:
         print(f"{r['omega_pi']:9.4f} " + " ".join(f"{s:>11d}/{c}" for s, c in (r["numba_dp5"], r["numba_tsit5"], r["jaxcelt_tsit5"], r["jaxcelt_dopri5"])))  # fmt: skip
     if a.out:
-        write_result(Path(a.out) / "max_steps_study.json", res, load_at_start=load0)
+        write_result(Path(a.out) / a.name, res, load_at_start=load0)
 
 
 if __name__ == "__main__":
