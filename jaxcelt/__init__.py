@@ -43,6 +43,7 @@ from jaxcelt.physics.state import check_state, constraint_residual, initial_stat
 from jaxcelt.studies.ladder import Scene, hertz_params, run_ladder
 from jaxcelt.sweeps.api import bifurcation, parameter_map, sweep_lanes
 from jaxcelt.sweeps.census import AttractorCensus, AttractorStarts, attractor_starts, attractors
+from jaxcelt.sweeps.atlas import AtlasOptions, AtlasResult, atlas
 from jaxcelt.sweeps.continuation import continue_attractors
 from jaxcelt.sweeps.continuation_options import ContinuationOptions
 from jaxcelt.sweeps.following import continuation
@@ -60,6 +61,9 @@ __all__ = [
     "attractor_starts",
     "attractors",
     "continue_attractors",
+    "atlas",
+    "AtlasOptions",
+    "AtlasResult",
     "ContinuationOptions",
     "CeltOrbit",
     "periodic_orbit",

@@ -17,7 +17,7 @@ import os
 import sys
 
 # Each entry is a module in jaxcelt.commands exposing register(subparsers).
-COMMANDS: tuple[str, ...] = ("simulate", "bifurcation", "fit", "ladder", "map", "orbits")
+COMMANDS: tuple[str, ...] = ("simulate", "bifurcation", "fit", "ladder", "map", "orbits", "atlas")
 
 
 class OneLineParser(argparse.ArgumentParser):

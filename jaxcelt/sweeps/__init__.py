@@ -11,6 +11,7 @@ Entry points:
 * `continuation`: `continue_attractors`, global continuation of the attractors over one parameter (seeds from
   the previous value, matching, basin fractions; resumable), on the model-agnostic `continuation_core`
   (`continue_section_attractors`, any forced ODE via `continuation_ode.forced_ode_model`);
+* `atlas`: `atlas`, everything over omega_pi at once (brute force, continuation, periodic branches, exponents);
 * `dense`: `dense_trajectory`, many states per period at one value, for phase plots.
 
 Their parts:
@@ -31,6 +32,9 @@ from jaxcelt.sweeps.api import bifurcation as bifurcation
 from jaxcelt.sweeps.api import parameter_map as parameter_map
 from jaxcelt.sweeps.api import sweep as sweep
 from jaxcelt.sweeps.api import sweep_lanes as sweep_lanes
+from jaxcelt.sweeps.atlas import AtlasOptions as AtlasOptions
+from jaxcelt.sweeps.atlas import AtlasResult as AtlasResult
+from jaxcelt.sweeps.atlas import atlas as atlas
 from jaxcelt.sweeps.census import Attractor as Attractor
 from jaxcelt.sweeps.census import AttractorCensus as AttractorCensus
 from jaxcelt.sweeps.census import AttractorStarts as AttractorStarts
