@@ -56,7 +56,7 @@ _RENAME = {"samples": "section", "t_samples": "t_section"}
 _DOCS = {
     "section": ("state at the stroboscopic times t0 + (transient + k) 2 pi/omega_pi", "SI (see state)"),
     "t_section": ("stroboscopic sample times", "s"),
-    "status": ("solver status: 0 success, 1 max_steps, 2 stopped invalid, 3 solver failure (e.g. a collapsed step size)", ""),
+    "status": ("solver status: 0 success, 1 max_steps, 2 stopped invalid, 3 solver failure (e.g. a collapsed step size), 4 on its side past validity (the heading's singularity)", ""),
     "valid": ("model stayed valid (N > 0, n3 > 0) on all accepted steps", ""),
     "first_invalid_t": ("time where validity was first lost (inf if never)", "s"),
     "first_invalid_kind": ("0 valid, 1 lift-off, 2 n3 <= 0, 3 constraint denominator <= 0", ""),
