@@ -9,14 +9,21 @@
   pair meets at +1 and continues as a neutral saddle, real multipliers e^{+-|w0| T}: kappa = cosh(|w0| T) > 1 for
   w0^2 < 0, checked to 1e-8) and the 1:4, 1:3 points at w0 = 1/4, 1/3 (to 1e-8); the 1:1 point, where this linear
   orbit is not isolated, is interpolated (to 1e-6).
-* Forced van der Pol x'' - 0.5 (1 - x^2) x' + x = F cos(w t): the torus (Neimark-Sacker) curve of the entrained
+* Forced van der Pol x'' - 0.5 (1 - x^2) x' + x = F cos(w t) (slow: about 35 s on the 2-core CPU): the torus (Neimark-Sacker) curve of the entrained
   period-1 orbit in (w, F) from w ~ 1.27, F = 1. At every fifth curve point with |kappa| < 1 an independent scipy
   integration (`solve_ivp` DOP853, rtol 1e-11, atol 1e-12, of the equation and its variational equations written
   here) from the curve's state returns to it within 1e-7 and has a complex pair of multipliers of modulus 1 to
-  1e-6 (measured: about 1e-10) whose angle is arccos(kappa) to 1e-6; at the located 1:3, 1:4 and 1:1 points the
+  1e-6 (measured: 3e-12) whose angle is arccos(kappa) to 1e-6; at the located 1:3, 1:4 and 1:1 points the
   scipy multipliers' angle is 2 pi / k to 1e-5 (the located test function is below 1e-6 of its bracket's).
 * Bad input: an unknown kind or detect name raises ValueError naming it.
+* The wobblestone (docs/orbits/curves_omega_q.json): every curve started on a branch passes its branch's
+  one-parameter point at q_pi = 0.04 (fold 14.8798 rad/s, docs/orbits/celt_fold_grad.json; NS 17.7475 rad/s,
+  docs/orbits/branches.json) to 1e-4 in omega_pi, on both mirror branches; NS points have a pair on the unit circle
+  to 1e-7, fold points a multiplier at +1 to 1e-7. Slow: the NS start recomputed on the mirror branch.
 """
+
+import json
+from pathlib import Path
 
 import jax.numpy as jnp
 import numpy as np
@@ -25,6 +32,7 @@ from scipy.integrate import solve_ivp
 
 import jaxcelt as jc
 from jaxcelt.orbits.ns_system import NS_TESTS, ns_tests
+from jaxcelt.physics.model import STATE_NAMES
 
 W0 = 1.0
 MU = 0.5
@@ -107,6 +115,7 @@ def _scipy_monodromy(y0, w, F):
     return sol.y[:2, -1], sol.y[2:, -1].reshape(2, 2)
 
 
+@pytest.mark.slow
 def test_forced_van_der_pol_torus_curve_against_scipy():
     c = jc.continue_bifurcation(
         vdp, jnp.array([-1.3383, -0.7657]), lambda w, F: (w, F), lambda a: 2 * jnp.pi / a[0], (1.27, 1.0),
@@ -142,3 +151,66 @@ def test_bad_kind_and_detect_name_it():
     with pytest.raises(ValueError, match="cusp"):
         jc.continue_bifurcation(vdp, jnp.zeros(2), lambda w, F: (w, F), period, (1.0, 1.0), ((0, 2), (0, 2)),
                                 kind="neimark-sacker", detect=("cusp",))  # fmt: skip
+
+
+# --- the wobblestone (docs/orbits/curves_omega_q.json from scripts/curves_omega_q.py) -------------------------------
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _one_parameter_points():
+    """The fold and NS values of each period-1 branch (branches.json) and the located fold (celt_fold_grad.json):
+    written by other scripts (orbit_branches.py, celt fold gradient), not by the curves script."""
+    d = json.loads((ROOT / "docs/orbits/branches.json").read_text())
+    fold = float(json.loads((ROOT / "docs/orbits/celt_fold_grad.json").read_text())["omega_fold"])
+    out = []
+    for b in d["branches"].values():
+        bif = {x["kind"]: x for x in b["branch"]["bifurcations"]}
+        out.append({"fold": fold, "neimark-sacker": float(bif["Neimark-Sacker"]["value"]), "bif": bif})
+    return out
+
+
+def test_committed_wobblestone_curves_pass_the_one_parameter_points():
+    # every curve started on a branch is refined at q_pi = 0.04 (the paper's) with omega_pi free: that point must be
+    # the one-parameter fold (14.8798) / NS point (17.7475) of its branch to 1e-4 in omega_pi (both are Newton or
+    # bisection solves to 1e-9 or better; 1e-4 is the stated check), on both mirror branches
+    res = json.loads((ROOT / "docs/orbits/curves_omega_q.json").read_text())
+    ref = _one_parameter_points()
+    seen = set()
+    for key, c in res["curves"].items():
+        if c.get("continues"):
+            continue
+        ib = int(key.endswith("_b"))
+        cd = c["curve"]
+        i = cd["start"]
+        assert cd["q_pi"][i] == pytest.approx(0.04, abs=1e-12)
+        assert abs(cd["omega_pi"][i] - ref[ib][c["kind"]]) < 1e-4, key
+        seen.add((c["kind"], ib))
+        mu = np.array([[complex(*z) for z in m] for m in cd["multipliers"]])
+        if c["kind"] == "neimark-sacker":  # a complex pair on the unit circle at every point
+            k = np.asarray(cd["kappa"])
+            assert np.all(np.abs(k) < 1.0)
+            pair = np.sort(np.abs(np.abs(mu) - 1.0), axis=1)[:, :2]
+            assert np.max(pair) < 1e-7
+        else:
+            assert np.max(np.min(np.abs(mu - 1.0), axis=1)) < 1e-7
+    assert seen == {("fold", 0), ("fold", 1), ("neimark-sacker", 0), ("neimark-sacker", 1)}
+    # the two mirror branches give the same curves (psi -> psi + pi is not built in: a check)
+    a, b = res["curves"]["ns_a"]["curve"], res["curves"]["ns_b"]["curve"]
+    assert abs(a["omega_pi"][a["start"]] - b["omega_pi"][b["start"]]) < 1e-6
+
+
+@pytest.mark.slow
+def test_wobblestone_ns_curve_starts_at_the_one_parameter_point_on_the_mirror_branch():
+    ref = _one_parameter_points()[1]
+    bif = ref["bif"]["Neimark-Sacker"]
+    y = np.array([bif["state"][n] for n in STATE_NAMES])
+    p = jc.CeltParams.paper(omega_pi=float(bif["value"]))
+    c = jc.continue_orbit_bifurcation(
+        p, y, ("omega_pi", "q_pi"), ((10.0, 20.0), (0.02, 0.06)), kind="neimark-sacker", scale=(1.0, 0.01),
+        max_points=1, max_steps=20_000,
+    )  # fmt: skip
+    assert len(c.p1) == 1 and c.p2[0] == pytest.approx(0.04, abs=1e-12)
+    assert abs(c.p1[0] - ref["neimark-sacker"]) < 1e-4
+    assert abs(np.sort(np.abs(np.abs(c.multipliers[0]) - 1.0))[1]) < 1e-7
+    assert 0 < c.theta[0] < np.pi

@@ -183,4 +183,4 @@ def draw_map_curves(ax, lines: list[dict], *, legend: bool = True) -> None:
             ax.plot(px, py, marker=m, color=colour, mec="white", ms=7, ls="")
             seen.setdefault(kind, Line2D([], [], marker=m, color=colour, mec="white", ls="", label=kind))
     if legend and seen:
-        ax.legend(handles=list(seen.values()), loc="lower right", fontsize=8, framealpha=0.85)
+        ax.legend(handles=list(seen.values()), loc="best", fontsize=8, framealpha=0.85)
