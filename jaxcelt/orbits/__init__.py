@@ -14,8 +14,10 @@ The model-agnostic layer they are built on, module by module:
   `trace_arclength`, and `branch_to_dict`.
 * `jaxcelt.orbits.points` -- bifurcation points on a branch: detection (test functions), location (bisection),
   and refinement with implicit-function-theorem derivatives (`locate_bifurcation`, bordered test functions).
-* `jaxcelt.orbits.curves` -- `continue_bifurcation`: a fold or period-doubling point continued in two parameters
-  (its curve, with cusps, fold-flip and 1:1 / 1:2 resonance points located on it).
+* `jaxcelt.orbits.curves` -- `continue_bifurcation`: a fold, period-doubling or Neimark-Sacker point continued in
+  two parameters (its curve, with cusps, fold-flip, fold-NS and 1:1 / 1:2 / 1:3 / 1:4 resonance points located on
+  it); the defining systems in `jaxcelt.orbits.curve_fold` (fold, period doubling) and `jaxcelt.orbits.ns_system`
+  (Neimark-Sacker).
 * `jaxcelt.orbits.switching` -- `switch_at_period_doubling`: the period-2k orbit that starts a new branch.
 * `jaxcelt.orbits.celt` -- the wobblestone's chart of the contact manifold (`celt_chart`, `celt_embed`) and the
   entry points above.
