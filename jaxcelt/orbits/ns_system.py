@@ -24,7 +24,10 @@ order), hence the choice per point.
 
 A root of the two chosen entries is accepted only where the other two vanish too (`G_TOL`). Past kappa = +-1
 the same system continues smoothly as a neutral-saddle curve (a real pair mu, 1/mu), which is
-not a bifurcation: the 1:1 and 1:2 points (kappa = 1, -1) separate the two. `NSSystem` follows
+not a bifurcation: the 1:1 and 1:2 points (kappa = 1, -1) separate the two. Where M is a multiple of I (a
+two-dimensional map that is the square of another, e.g. a forced oscillator with the symmetry x -> -x, t -> t + T/2,
+whose monodromy is A^2 with A's eigenvalues +-i s) B vanishes too: such a curve can meet a Neimark-Sacker curve at
+a 1:2 point and the continuation may follow it (|kappa| > 1 there as well). `NSSystem` follows
 `jaxcelt.orbits.curve_fold.FoldSystem`'s interface (``residual``, ``start``, ``recentre``, ``observe``,
 ``tests``) for the driver `jaxcelt.orbits.curves.continue_bifurcation`; unknowns u = (z, kappa, p1 / s1,
 p2 / s2), reference (y_ref, V, W, entries).
