@@ -50,6 +50,7 @@ from jaxcelt.sweeps.following import continuation
 from jaxcelt.sweeps.following import follow_attractor as follow_attractor  # new name of continuation
 from jaxcelt.sweeps.options import SweepOptions
 from jaxcelt.sweeps.result import SweepResult
+from jaxcelt.sweeps.zero_one import zero_one_test
 
 __version__ = "0.1.0"
 
@@ -61,6 +62,7 @@ __all__ = [
     "attractor_starts",
     "attractors",
     "continue_attractors",
+    "zero_one_test",
     "atlas",
     "AtlasOptions",
     "AtlasResult",

@@ -190,3 +190,11 @@ def _gap_degrees() -> str:
 
 
 QUOTES += [(STATUS_PAGE, lambda: f"(on its side to within about {_gap_degrees()}°)")]
+
+QUOTES += [
+    (
+        "README.md",
+        lambda: "the published Lorenz GPU ensemble benchmark, {} trajectories, in {} ms on one H200 against {} ms for "
+        "diffrax's vmap on the same card".format(_v("LORENZN"), _v("K32"), _v("D32")),
+    )
+]
