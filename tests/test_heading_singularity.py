@@ -28,7 +28,14 @@ def _lane(engine: str, stop_on_invalid: bool, periods: tuple[int, int] = (200, 1
 
 
 def test_status_4_is_documented():
+    import math
+    from pathlib import Path
+
     assert "singularity" in STATUS[4]
+    # the status-codes page gives the angle HEADING_GAP leaves: arcsin(sqrt(gap)) in degrees
+    deg = math.degrees(math.asin(math.sqrt(HEADING_GAP)))
+    page = (Path(__file__).resolve().parents[1] / "docs/explanation/status-codes.md").read_text(encoding="utf-8")
+    assert f"to within about {deg:.2f}".rstrip("0") + "°" in " ".join(page.split())
 
 
 def test_lane_on_its_side_ends_with_status_4():
