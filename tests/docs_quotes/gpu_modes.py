@@ -181,14 +181,6 @@ SETTINGS = [
 STATUS_PAGE = "docs/explanation/status-codes.md"
 
 
-def _gap_degrees() -> str:
-    import math
-
-    from jaxcelt.integrate.solve import HEADING_GAP
-
-    return f"{math.degrees(math.asin(math.sqrt(HEADING_GAP))):.2f}".rstrip("0")
-
-
 SETTINGS += [(STATUS_PAGE, "(on its side to within about 0.06°)")]  # tests/test_heading_singularity.py checks it
 
 QUOTES += [
