@@ -22,6 +22,9 @@ from pathlib import Path
 
 from jaxcelt.commands.args import UsageError, nonnegative_int, positive_float, positive_int
 
+READ_OFF = (14.0, 15.6, 17.0, 19.0)
+"""the paper's frequencies [rad/s]: added to the values inside the window; atlas.json lists the attractors there"""
+
 
 def register(sub) -> None:
     p = sub.add_parser(
@@ -33,7 +36,8 @@ def register(sub) -> None:
     p.add_argument("--out", type=Path, required=True, help="output directory")
     p.add_argument("--omega", type=positive_float, nargs=2, default=(10.0, 20.0), metavar=("A", "B"),
                    help="omega_pi window [rad/s]")  # fmt: skip
-    p.add_argument("--values", type=positive_int, default=21, help="continuation values over the window (>= 2)")
+    p.add_argument("--values", type=positive_int, default=21,
+                   help="continuation values over the window (>= 2), plus 14, 15.6, 17, 19 where inside it")  # fmt: skip
     p.add_argument("--starts", type=positive_int, nargs=2, default=(8, 4), metavar=("N_PSI0", "N_TILT"),
                    help="fresh starts at rest: headings over a full turn x tilts in +-0.1 rad")  # fmt: skip
     p.add_argument("--transient", type=nonnegative_int, default=100, help="transient periods of every lane")
@@ -91,7 +95,8 @@ def run(args) -> int:
         branches=not args.no_branches, branch_max_points=args.branch_points,
         out=str(args.out / "continuation"), progress=True,
     )  # fmt: skip
-    values = np.linspace(lo, hi, args.values)
+    # the paper's frequencies inside the window are values too (the figure and atlas.json read them off)
+    values = np.unique(np.round(np.r_[np.linspace(lo, hi, args.values), [w for w in READ_OFF if lo < w < hi]], 10))
     args.out.mkdir(parents=True, exist_ok=True)
     load = load_average()
     with one_line_warnings("atlas"):
@@ -110,6 +115,10 @@ def run(args) -> int:
     summary["seconds"]["command"] = round(time.perf_counter() - t_command, 2)
     summary["seconds_note"] = "each part's first calls include their compilation (the XLA cache may hold some)"
     summary["command"] = "jaxcelt atlas"
+    summary["read_off"] = {
+        f"{w:g}": next(r for r in summary["continuation"]["values"] if abs(r["value"] - w) < 1e-9)
+        for w in READ_OFF if lo < w < hi
+    }
     write_result(args.out / "atlas.json", summary, load_at_start=load, indent=None)
     for row in summary["continuation"]["values"]:
         parts = [f"#{a['id']} {a['kind']}{a['period'] or ''} {a['fraction']:.3f}" for a in row["attractors"]]

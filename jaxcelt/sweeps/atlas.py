@@ -8,8 +8,9 @@
    starts at every value plus seeds, matched from value to value; resumable through ``out``);
 3. the **periodic branches** through the continuation's period-1 / period-2 orbits (`jaxcelt.continue_orbit`, both
    ways to the window's ends, through folds; stability along them; fold / period-doubling / Neimark-Sacker points).
-   Each orbit of the continuation that does not lie on a branch already found starts a new one, so the mirror pair
-   (psi differing by 180 deg) gives two branches;
+   Each orbit of the continuation that does not lie on a branch already found starts a new one; the half-turn image
+   of a branch (`half_turn`: the mirror pair, psi differing by 180 deg) is its second branch, checked by one Newton
+   solve and not continued again;
 4. the **Lyapunov exponents** of every attractor at every value: lambda_1 (and its standard error) from the
    continuation's lanes (``lyapunov_periods > 0``) and, with ``spectrum_periods > 0``, lambda_1 and lambda_2 from
    `jaxcelt.lyapunov_spectrum` started at the attractor's representative section point (one vmapped batch).
@@ -262,7 +263,7 @@ def _branches(params: CeltParams, ds, window: tuple[float, float], o: AtlasOptio
     if o.progress and seeds:
         from tqdm.auto import tqdm
 
-        bar = tqdm(total=min(len(seeds), o.max_branches), unit="branch", desc="periodic branches")
+        bar = tqdm(unit="branch", desc="periodic branches (continued)")
     for a, j, k in seeds:
         if len(out) >= o.max_branches:
             break
@@ -279,12 +280,49 @@ def _branches(params: CeltParams, ds, window: tuple[float, float], o: AtlasOptio
             lo, hi = min(lo, w - 1e-3 * span), max(hi, w + 1e-3 * span)
         br = jc.continue_orbit(p, orb, "omega_pi", (lo, hi), max_points=o.branch_max_points)
         psi = float(np.degrees(np.asarray(orb.y)[12]) % 360)
-        out.append((f"period-{k} through #{a} at {w:g} rad/s (psi {psi:.0f} deg)", br))
+        out.append((f"period-{k} through #{a} at {w:g} rad/s (ψ {psi:.0f}°)", br))
         if bar is not None:
             bar.update(1)
+        mirror = _mirror_branch(p, br, k) if len(out) < o.max_branches else None
+        if mirror is not None:  # the half-turn image is an orbit too: its branch without a second continuation
+            out.append((f"period-{k}, its half-turn image (ψ {(psi + 180) % 360:.0f}°)", mirror))
     if bar is not None:
         bar.close()
     return out
+
+
+HALF_TURN = np.array([-1.0, -1.0, 1.0, -1.0, -1.0, 1.0, -1.0, -1.0, 1.0, 1.0, 1.0, 1.0, 1.0])
+"""signs of the state's components under the half turn about the body's x3 axis (with psi -> psi + pi): the same
+stone described in axes turned by pi (MODEL.md section 10; tests/test_symmetry.py). For a stone symmetric under it
+(the paper's: B12, the shape and the centre of mass are) it maps every orbit to an orbit, the mirror pair's two
+members onto each other."""
+
+
+def half_turn(y: np.ndarray) -> np.ndarray:
+    """The half-turn image of states ``y`` (..., 13): body components of v, omega, n times (-1, -1, 1), psi + pi."""
+    y = np.asarray(y, dtype=np.float64) * HALF_TURN
+    y[..., 12] = np.mod(y[..., 12] + np.pi, 2 * np.pi)
+    return y
+
+
+def _mirror_branch(params: CeltParams, br, k: int):
+    """The half-turn image of ``br`` if it is a different orbit of this stone (checked by one Newton solve at the
+    image of the branch's start: it must converge onto the image within 1e-7); else None."""
+    import jaxcelt as jc
+
+    i = int(br.start)
+    y, yi = np.asarray(br.y[i]), half_turn(br.y[i])
+    d = np.abs(yi - y)
+    d[12] = abs(np.mod(yi[12] - y[12] + np.pi, 2 * np.pi) - np.pi)
+    if d.max() < 1e-6:  # symmetric orbit: its own image
+        return None
+    orb = jc.periodic_orbit(params.replace(omega_pi=float(br.values[i])), yi, k=k)
+    e = np.abs(np.asarray(orb.y) - yi)
+    e[12] = abs(np.mod(float(orb.y[12]) - yi[12] + np.pi, 2 * np.pi) - np.pi)
+    if int(orb.status) != 0 or e.max() > 1e-7:
+        return None
+    bifs = [b._replace(y=half_turn(b.y)) for b in br.bifurcations]
+    return br._replace(y=half_turn(br.y), bifurcations=bifs)
 
 
 def _spectra(params: CeltParams, ds, o: AtlasOptions) -> list[np.ndarray]:
