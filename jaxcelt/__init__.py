@@ -42,8 +42,8 @@ from jaxcelt.physics.params import PARAM_NAMES, CeltParams
 from jaxcelt.physics.state import check_state, constraint_residual, initial_state, project_state
 from jaxcelt.studies.ladder import Scene, hertz_params, run_ladder
 from jaxcelt.sweeps.api import bifurcation, parameter_map, sweep_lanes
-from jaxcelt.sweeps.census import AttractorCensus, AttractorStarts, attractor_starts, attractors
 from jaxcelt.sweeps.atlas import AtlasOptions, AtlasResult, atlas
+from jaxcelt.sweeps.census import AttractorCensus, AttractorStarts, attractor_starts, attractors
 from jaxcelt.sweeps.continuation import continue_attractors
 from jaxcelt.sweeps.continuation_options import ContinuationOptions
 from jaxcelt.sweeps.following import continuation
