@@ -1,0 +1,374 @@
+"""The paper's periodic motion at 14 rad/s, asked of the fold of the period-1 family -> docs/orbits/paper_14.json and
+docs/orbits/paper_14.png.
+
+The period-1 family of the 15.6 rad/s orbit begins at its fold, 14.8798 rad/s with the paper's values
+(docs/orbits/celt_fold_grad.json). A stable period-1 orbit lives on one side of the fold only, so it can reach
+omega_pi = 14 rad/s only where the fold does. This script follows the fold (`jaxcelt.continue_orbit_bifurcation`,
+with the start, bounds and solver limits of `scripts/fold_curves.py`) in omega_pi and each reading of MODEL.md
+section 9 that is a continuous `CeltParams` field, from the default reading towards the alternative:
+
+- ``B12`` (A5, the sign of the product of inertia) from +1.728e-4 towards -1.728e-4. The mirror x2 -> -x2 maps the
+  stone with B12 onto the stone with -B12 (MODEL.md section 10), so omega_fold(B12) = omega_fold(-B12): the curve is
+  followed from +B12 to 0, its other half is its mirror image.
+- ``derivative_exact`` (A13a) from 0 (eq. 13 as printed) to 1: the contact law blends the two groupings linearly
+  (fac = b_Ts (1 - de) + de), so every value between is a model.
+- ``k_r`` (the rolling-resistance coefficient), both ways from the paper's value, as the remaining parameter of
+  `scripts/fold_curves.py` that had no curve.
+
+``v_pi_sign`` (A12) is not continued: the base velocity is s_pi q_pi omega_pi sin(omega_pi t) E1 and nothing else
+depends on time, so s_pi = -1 is the same system shifted by half a forcing period (same orbits, same multipliers,
+same fold), and a real s_pi between is the amplitude s_pi q_pi, i.e. the (omega_pi, q_pi) curve of fold_curves.json;
+at s_pi = 0 there is no forcing at all.
+
+Each curve runs as its own process (``--curve KEY --part FILE``) and the parts are merged (``--merge``); then
+``--orbits`` solves the period-1 orbit at 14 rad/s wherever a curve crosses it (multipliers) and runs the motion
+from it over a few hundred periods (drift of O), and does the same for the 15.6 rad/s orbit at the curves' ends.
+Timings are indicative (load average recorded; each process compiles its own corrector).
+
+    python scripts/paper_14.py --curve B12 --part /tmp/p14_B12.json
+    python scripts/paper_14.py --merge /tmp/p14_*.json
+    python scripts/paper_14.py --orbits
+    python scripts/paper_14.py --plot-only
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import pathlib
+import sys
+import time
+
+import numpy as np
+
+import jaxcelt as jc
+from jaxcelt.orbits.curves import curve_to_dict
+from jaxcelt.provenance import write_result
+from jaxcelt.versions import versions
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "scripts"))
+from fold_curves import MAX_STEPS, OMEGA_BOUNDS, fold_start, located_fold  # noqa: E402
+
+OUT = ROOT / "docs/orbits/paper_14.json"
+OMEGA_PAPER = 14.0
+B12_PAPER = 1.728e-4
+
+# key -> (parameter, bounds, scale, direction (+1/-1 towards increasing/decreasing parameter, 0 both), ds, ds_max,
+# points at most)
+CURVES = {
+    "B12": ("B12", (-2e-4, 2e-4), 1e-4, -1, 0.2, 0.5, 9),
+    "derivative_exact": ("derivative_exact", (0.0, 1.0), 0.5, +1, 0.2, 0.5, 9),
+    "k_r": ("k_r", (0.0, 1.2), 0.1, 0, 0.2, 1.0, 9),
+}
+
+
+def crossing(omega: np.ndarray, p: np.ndarray, level: float = OMEGA_PAPER) -> list[dict]:
+    """Where the piecewise-linear curve through (omega[i], p[i]) crosses omega = ``level``: linear interpolation
+    between consecutive points on either side (a point exactly on the level counts once). Pure, for the curves'
+    read-off and its test."""
+    w, q = np.asarray(omega, float), np.asarray(p, float)
+    if w.shape != q.shape or w.ndim != 1:
+        raise ValueError(f"crossing: 'omega' and 'p' must be 1-d of one length, got {w.shape} and {q.shape}")
+    out = []
+    for i in range(len(w) - 1):
+        a, b = w[i] - level, w[i + 1] - level
+        if a == 0 or a * b < 0:
+            s = 0.0 if a == 0 else a / (a - b)
+            out.append({"segment": i, "p": float(q[i] + s * (q[i + 1] - q[i]))})
+    if len(w) and w[-1] == level:
+        out.append({"segment": len(w) - 1, "p": float(q[-1])})
+    return out
+
+
+def run_curve(key: str) -> dict:
+    name, bounds, scale, direction, ds, ds_max, max_points = CURVES[key]
+    y, w = fold_start()
+    p = jc.CeltParams.paper(omega_pi=w)
+    p0 = float(getattr(p, name))
+    times: list[float] = []
+    t0 = time.perf_counter()
+
+    def cb(n, v, ok):
+        times.append(time.perf_counter() - t0)
+        print(f"  [{key}] point {n} {name} = {v:.6g} {'ok' if ok else 'retry'} ({times[-1]:.0f} s)", flush=True)
+
+    curve = jc.continue_orbit_bifurcation(
+        p, y, ("omega_pi", name), (OMEGA_BOUNDS, bounds), scale=(1.0, scale), ds=ds, ds_max=ds_max,
+        max_points=max_points, max_steps=MAX_STEPS, callback=cb, direction=direction,
+    )  # fmt: skip
+    total = time.perf_counter() - t0
+    om, pp = np.asarray(curve.p1), np.asarray(curve.p2)
+    i0 = curve.start
+    a, b = max(i0 - 1, 0), min(i0 + 1, len(om) - 1)
+    return {
+        "parameter": name,
+        "paper_value": p0,
+        "bounds": list(bounds),
+        "scale": scale,
+        "direction": direction,
+        "ds": ds,
+        "ds_max": ds_max,
+        "max_points": max_points,
+        "points": len(om),
+        "start_minus_located_fold": float(om[i0] - located_fold()),
+        "range_reached": [float(pp.min()), float(pp.max())],
+        "omega_range": [float(om.min()), float(om.max())],
+        "domega_dp_at_start": float((om[b] - om[a]) / (pp[b] - pp[a])) if b > a and pp[b] != pp[a] else None,
+        "max_abs_multiplier_minus_1": float(np.max(np.min(np.abs(curve.multipliers - 1.0), axis=1))),
+        "seconds": {
+            "to_first_step_incl_compile": round(times[0], 1) if times else None,
+            "total": round(total, 1),
+            "corrector_attempts": len(times),
+        },
+        "curve": curve_to_dict(curve, ("omega_pi", name)),
+    }
+
+
+PERIODS = 300
+"""forcing periods of the motion run from an orbit to judge its global motion"""
+DRIFT_THRESHOLD = 0.05
+"""[m] net displacement of O that counts as unbounded wandering (`jaxcelt.sweeps.regimes.classify`'s default)"""
+END_VALUES = {"B12": 0.0, "derivative_exact": 1.0}
+"""the far end of each move for the 15.6 rad/s orbit (B12 = 0: half way to -B12, whose stone is the mirror image)"""
+
+
+def _params(name: str, value: float, omega: float) -> jc.CeltParams:
+    """The paper's stone at omega_pi with ``name`` (a field or "a=b") set to value; set by `eqx.tree_at`, so a
+    reading switch may take a value between its two readings (CeltParams' validation admits 0/1 and +-1 only)."""
+    import equinox as eqx
+    import jax.numpy as jnp
+
+    fields = name.split("=")
+    return eqx.tree_at(lambda q: [getattr(q, f) for f in fields], jc.CeltParams.paper(omega_pi=omega),
+                       [jnp.asarray(value, float)] * len(fields))  # fmt: skip
+
+
+def global_motion(params: jc.CeltParams, y0: np.ndarray, periods: int = PERIODS) -> dict:
+    """Run ``periods`` forcing periods from the section state y0 (t0 = 0), sampled on the section: net drift and
+    largest excursion of O, the classify rule's label, and how far the samples wander from y0 (a periodic orbit
+    that holds stays at 0)."""
+    import jax
+
+    from jaxcelt.physics.diagnostics import centre_position
+
+    T = 2 * np.pi / float(params.omega_pi)
+    ts = T * np.arange(periods + 1)
+    t = time.perf_counter()
+    sol = jc.simulate(params, y0, ts[-1], ts=ts, rtol=1e-10, atol=1e-12, max_steps=20_000 * periods)
+    ys = np.asarray(sol.ys)
+    r_O = np.asarray(jax.vmap(centre_position, in_axes=(0, None))(sol.ys, params))
+    d = r_O[:, :2] - r_O[0, :2]
+    dist = np.linalg.norm(d, axis=-1)
+    net, exc = float(dist[-1]), float(np.max(dist))
+    dev = np.max(np.abs(ys[:, 3:9] - ys[0, 3:9]), axis=-1)
+    return {
+        "periods": periods,
+        "status": int(sol.status),
+        "valid": bool(np.all(np.asarray(sol.valid))),
+        "net_drift_m": net,
+        "max_excursion_m": exc,
+        "drift_per_period_first_m": float(dist[1]),
+        "global_motion": "unbounded" if (net > DRIFT_THRESHOLD and net >= 0.5 * exc) else "bounded",
+        "max_section_deviation_omega_n": float(np.max(dev)),
+        "left_orbit_at_period": int(np.argmax(dev > 1e-3)) if np.any(dev > 1e-3) else None,
+        "seconds_incl_compile": round(time.perf_counter() - t, 1),
+    }
+
+
+def _orbit_record(params, o) -> dict:
+    return {
+        "status": int(o.status),
+        "residual": float(o.residual),
+        "multipliers_abs": [float(a) for a in np.abs(np.asarray(o.multipliers))],
+        "stable": bool(o.stable),
+        "state": [float(v) for v in np.asarray(o.y)],
+    }
+
+
+def sheets_at_14(name: str, cd: dict, seg: int) -> dict:
+    """Both orbits born at the fold, at omega_pi = 14: at fixed parameter value p of the curve point of segment
+    ``seg`` whose fold lies below 14 rad/s, `jc.continue_orbit` in omega_pi from just above that fold through it
+    (both sheets) up to 14.05 rad/s; each sheet's point nearest 14 is polished by `jc.periodic_orbit` at exactly
+    14 rad/s, and the motion from it is run `PERIODS` periods."""
+    om = cd["omega_pi"]
+    j = seg if om[seg] < OMEGA_PAPER else seg + 1
+    wf, pv, y = float(om[j]), float(cd[name][j]), np.asarray(cd["state"][j])
+    t = time.perf_counter()
+    p = _params(name, pv, wf + 0.02)
+    o = jc.periodic_orbit(p, y, max_steps=MAX_STEPS)
+    out = {"curve_point": j, "fold_omega": wf, name: pv, "start_status": int(o.status)}
+    if int(o.status) != 0:
+        return out
+    br = jc.continue_orbit(p, o, "omega_pi", (wf - 0.3, OMEGA_PAPER + 0.05), ds=0.02, ds_max=0.15, max_points=60,
+                           max_steps=MAX_STEPS)  # fmt: skip
+    v = np.asarray(br.values)
+    out["branch"] = {"omega_pi": v.tolist(), "stable": np.asarray(br.stable).tolist(),
+                     "max_abs_multiplier": np.max(np.abs(np.asarray(br.multipliers)), axis=1).tolist(),
+                     "stopped": str(getattr(br, "stopped", ""))}  # fmt: skip
+    sheets = []
+    for c in crossing(v, np.arange(len(v), dtype=float)):
+        i = (
+            c["segment"]
+            if abs(v[c["segment"]] - 14) <= abs(v[min(c["segment"] + 1, len(v) - 1)] - 14)
+            else c["segment"] + 1
+        )
+        p14 = _params(name, pv, OMEGA_PAPER)
+        o14 = jc.periodic_orbit(p14, np.asarray(br.y[i]), max_steps=MAX_STEPS)
+        rec = {"branch_point": int(i), **_orbit_record(p14, o14)}
+        if int(o14.status) == 0:
+            rec["motion"] = global_motion(p14, np.asarray(o14.y))
+        sheets.append(rec)
+    out["sheets_at_14"] = sheets
+    out["seconds_incl_compile"] = round(time.perf_counter() - t, 1)
+    return out
+
+
+def orbit_156(name: str, end: float) -> dict:
+    """The stable 15.6 rad/s orbit (docs/orbits/branches.json) at the paper's values and continued in ``name``
+    to ``end`` (`jc.continue_orbit` at omega_pi = 15.6): its multipliers and global motion at both ends."""
+    d = json.loads((ROOT / "docs/orbits/branches.json").read_text())
+    br = next(iter(d["branches"].values()))["branch"]
+    v = np.asarray(br["values"])
+    i = int(np.argmin(np.abs(v - 15.6) + 100 * ~np.asarray(br["stable"])))
+    from jaxcelt.physics.model import STATE_NAMES
+
+    y = np.array([br["state"][n][i] for n in STATE_NAMES])
+    t = time.perf_counter()
+    p = jc.CeltParams.paper(omega_pi=float(v[i]))
+    o = jc.periodic_orbit(p, y, max_steps=MAX_STEPS)
+    out = {
+        "parameter": name,
+        "end_value": end,
+        "default": {**_orbit_record(p, o), "motion": global_motion(p, np.asarray(o.y))},
+    }
+    b2 = jc.continue_orbit(p, o, name, end, ds=0.05 * abs(end - float(getattr(p, name)) or 1),
+                           ds_max=0.3 * abs(end - float(getattr(p, name)) or 1), max_points=40, max_steps=MAX_STEPS)  # fmt: skip
+    vals = np.asarray(b2.values)
+    k = int(np.argmin(np.abs(vals - end)))
+    pe = _params(name, float(vals[k]), float(v[i]))
+    oe = jc.periodic_orbit(_params(name, end, float(v[i])), np.asarray(b2.y[k]), max_steps=MAX_STEPS)
+    out["branch"] = {name: vals.tolist(), "stable": np.asarray(b2.stable).tolist()}
+    out["end"] = {**_orbit_record(pe, oe)}
+    if int(oe.status) == 0:
+        out["end"]["motion"] = global_motion(_params(name, end, float(v[i])), np.asarray(oe.y))
+    out["seconds_incl_compile"] = round(time.perf_counter() - t, 1)
+    return out
+
+
+def summarise(res: dict) -> None:
+    """Per curve: its crossings of 14 rad/s, lowest fold and slope at the paper's value; per orbit check: stable or
+    saddle at 14 rad/s and the global motion; and the plain answer."""
+    fold = located_fold()
+    lines = []
+    for c in res["curves"].values():
+        name, cd = c["parameter"], c["curve"]
+        om, pv = np.asarray(cd["omega_pi"]), np.asarray(cd[name])
+        j = int(np.argmin(om))
+        c["lowest_fold"] = {"omega_pi": float(om[j]), name: float(pv[j])}
+        c["crossings_of_14"] = crossing(om, pv)
+        c["closest_to_14_rad_s"] = float(om[j] - OMEGA_PAPER)
+        lines.append(
+            f"{name} over [{pv.min():.4g}, {pv.max():.4g}]: fold {om.min():.4f}-{om.max():.4f} rad/s, "
+            + (f"crosses 14 rad/s at {name} = {', '.join(format(x['p'], '.4g') for x in c['crossings_of_14'])}"
+               if c["crossings_of_14"] else f"nearest 14 rad/s: {om[j]:.4f} at {name} = {pv[j]:.4g}")
+        )  # fmt: skip
+    stable_bounded = []
+    for a in res.get("at_14", {}).values():
+        for s in a.get("sheets_at_14", []):
+            s["bounded_and_stable"] = bool(s["stable"] and s.get("motion", {}).get("global_motion") == "bounded")
+            if s["bounded_and_stable"]:
+                stable_bounded.append(f"{a['parameter']} = {a[a['parameter']]:.4g}")
+    res["located_fold_omega"] = fold
+    res["stable_bounded_period1_at_14"] = stable_bounded
+    res["answer"] = "; ".join(lines)
+
+
+def plot(res: dict, path: pathlib.Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    keys = list(res["curves"])
+    fig, axes = plt.subplots(1, max(len(keys), 1), figsize=(4.2 * max(len(keys), 1), 3.8), squeeze=False)
+    for ax, key in zip(axes[0], keys, strict=False):
+        c = res["curves"][key]
+        name, cd = c["parameter"], c["curve"]
+        ax.plot(cd["omega_pi"], cd[name], ".-", lw=1, ms=3, color="C0", label="fold curve")
+        if name == "B12":  # the mirror half: omega_fold(B12) = omega_fold(-B12)
+            ax.plot(cd["omega_pi"], -np.asarray(cd[name]), ".--", lw=1, ms=3, color="C0", alpha=0.5,
+                    label="mirror image (−B12)")  # fmt: skip
+        ax.plot([res["located_fold_omega"]], [c["paper_value"]], "r*", ms=10, label="paper's reading")
+        ax.axvline(OMEGA_PAPER, color="k", ls="--", lw=0.8, label="ω_π = 14 rad/s")
+        for pt in cd["points"]:
+            ax.plot([pt["omega_pi"]], [pt[name]], "ks", mfc="none", ms=7)
+            ax.annotate(pt["kind"], (pt["omega_pi"], pt[name]), fontsize=7)
+        ax.set_xlabel("ω_π [rad/s]")
+        ax.set_ylabel(name)
+        ax.set_title(f"fold in (ω_π, {name})", fontsize=10)
+        ax.legend(fontsize=7, loc="best")
+    fig.suptitle("wobblestone: the fold where the period-1 family begins, moved by each reading", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--curve", choices=list(CURVES))
+    ap.add_argument("--part", type=pathlib.Path, help="where --curve writes its curve")
+    ap.add_argument("--merge", nargs="*", type=pathlib.Path, default=[])
+    ap.add_argument("--at14", nargs=2, metavar=("CURVE", "SEGMENT"), help="sheets at 14 rad/s from a curve's crossing")
+    ap.add_argument("--at156", choices=list(END_VALUES), help="the 15.6 rad/s orbit moved to the end of a reading")
+    ap.add_argument("--plot-only", action="store_true")
+    ap.add_argument("--out", type=pathlib.Path, default=OUT)
+    a = ap.parse_args(argv)
+    if a.curve:
+        load0 = list(os.getloadavg())
+        part = {"curves": {a.curve: run_curve(a.curve)}, "load_average_start": load0}
+        part["load_average_end"] = list(os.getloadavg())
+        a.part.write_text(json.dumps(part, indent=1))
+        return 0
+    if a.at156:
+        load0 = list(os.getloadavg())
+        part = {"at_15_6": {a.at156: orbit_156(a.at156, END_VALUES[a.at156])}, "load_average_start": load0}
+        a.part.write_text(json.dumps(part, indent=1))
+        return 0
+    if a.at14:
+        key, seg = a.at14[0], int(a.at14[1])
+        load0 = list(os.getloadavg())
+        src = json.loads((ROOT / "docs/orbits/fold_curves.json").read_text())["curves"]
+        if key not in src:
+            src = json.loads(a.part.with_name(key + ".json").read_text())["curves"]
+        name = src[key]["parameter"]
+        part = {"at_14": {f"{key}:{seg}": {"curve": key, "parameter": name, **sheets_at_14(name, src[key]["curve"], seg)}},
+                "load_average_start": load0}  # fmt: skip
+        a.part.write_text(json.dumps(part, indent=1))
+        return 0
+    res = json.loads(a.out.read_text()) if a.out.exists() else {}
+    res.pop("provenance", None)
+    if a.merge:
+        load0 = None
+        res.setdefault("curves", {})
+        for f in a.merge:
+            part = json.loads(f.read_text())
+            load0 = load0 or part["load_average_start"]
+            for k in ("curves", "at_14", "at_15_6"):
+                res.setdefault(k, {}).update(part.get(k, {}))
+        res.update(
+            system="paper's stone (CeltParams.paper), fold of the period-1 family of the 15.6 rad/s orbit",
+            omega_bounds=list(OMEGA_BOUNDS), max_steps=MAX_STEPS, periods_run=PERIODS,
+            drift_threshold_m=DRIFT_THRESHOLD, merged_from_parallel_runs=len(a.merge),
+            load_average_start=load0, load_average_end=list(os.getloadavg()), versions=versions(),
+        )  # fmt: skip
+        summarise(res)
+        write_result(a.out, res, load_at_start=load0, indent=1)
+    plot(res, a.out.with_suffix(".png"))
+    print(json.dumps({k: v for k, v in res.items() if k not in ("curves", "versions", "provenance")}, indent=1)[:4000])
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
