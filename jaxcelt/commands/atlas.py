@@ -36,19 +36,19 @@ def register(sub) -> None:
     p.add_argument("--out", type=Path, required=True, help="output directory")
     p.add_argument("--omega", type=positive_float, nargs=2, default=(10.0, 20.0), metavar=("A", "B"),
                    help="omega_pi window [rad/s]")  # fmt: skip
-    p.add_argument("--values", type=positive_int, default=21,
+    p.add_argument("--values", type=positive_int, default=11,
                    help="continuation values over the window (>= 2), plus 14, 15.6, 17, 19 where inside it")  # fmt: skip
-    p.add_argument("--starts", type=positive_int, nargs=2, default=(8, 4), metavar=("N_PSI0", "N_TILT"),
+    p.add_argument("--starts", type=positive_int, nargs=2, default=(8, 3), metavar=("N_PSI0", "N_TILT"),
                    help="fresh starts at rest: headings over a full turn x tilts in +-0.1 rad")  # fmt: skip
     p.add_argument("--transient", type=nonnegative_int, default=100, help="transient periods of every lane")
     p.add_argument("--sample", type=positive_int, default=16, help="sampled section periods of every lane")
-    p.add_argument("--lyapunov-periods", type=nonnegative_int, default=50,
+    p.add_argument("--lyapunov-periods", type=nonnegative_int, default=40,
                    help="periods of lambda_1 on every lane (0: off)")  # fmt: skip
-    p.add_argument("--spectrum-periods", type=nonnegative_int, default=40,
+    p.add_argument("--spectrum-periods", type=nonnegative_int, default=20,
                    help="periods of the Lyapunov spectrum (lambda_1, lambda_2) per attractor and value (0: off)")  # fmt: skip
-    p.add_argument("--brute-values", type=nonnegative_int, default=101, help="brute-force values over the window")
-    p.add_argument("--brute-transient", type=nonnegative_int, default=150, help="brute-force transient periods")
-    p.add_argument("--brute-sample", type=positive_int, default=32, help="brute-force sampled periods")
+    p.add_argument("--brute-values", type=nonnegative_int, default=51, help="brute-force values over the window")
+    p.add_argument("--brute-transient", type=nonnegative_int, default=100, help="brute-force transient periods")
+    p.add_argument("--brute-sample", type=positive_int, default=24, help="brute-force sampled periods")
     p.add_argument("--branch-points", type=positive_int, default=120, help="points per periodic branch at most")
     p.add_argument("--no-branches", action="store_true", help="do not continue periodic branches")
     p.add_argument("--q-pi", type=positive_float, default=0.04, help="base amplitude q_pi [m]")

@@ -16,6 +16,28 @@ import numpy as np
 __all__ = ["plot_atlas", "atlas_figure"]
 
 _TIPPING = "#d62728"
+READ_OFF = (14.0, 15.6, 17.0, 19.0)
+"""the paper's frequencies [rad/s], marked by dotted lines"""
+
+
+def _clip(ax, res, branch_ys: list) -> None:
+    """Limit omega_2 to the branches and the bulk (2nd-98th percentile) of the brute-force points, so that a few
+    fast-spinning lanes do not squash the branches; say so on the panel when points are cut off."""
+    ys = [np.concatenate(branch_ys)] if branch_ys else []
+    pts = np.asarray(res.brute.samples)[..., 4] if res.brute is not None else np.zeros(0)
+    pts = pts[np.isfinite(pts)]
+    if pts.size:
+        ys.append(np.percentile(pts, [2, 98]))
+    if not ys:
+        return
+    lo, hi = float(np.min(np.concatenate(ys))), float(np.max(np.concatenate(ys)))
+    pad = 0.15 * max(hi - lo, 0.2)
+    lo, hi = lo - pad, hi + pad
+    ax.set_ylim(lo, hi)
+    cut = int(np.sum((pts < lo) | (pts > hi)))
+    if cut:
+        ax.text(0.995, 0.015, f"{cut} of {pts.size} brute-force points beyond this range (fast spin) not shown",
+                transform=ax.transAxes, ha="right", va="bottom", fontsize=7, color="0.35")  # fmt: skip
 
 
 def _palette(n: int) -> list:
@@ -43,7 +65,7 @@ def _kind_runs(ds, a: int) -> str:
     return f"#{a}: " + ", ".join(parts)
 
 
-def _branch_panel(ax, res) -> None:
+def _branch_panel(ax, res, colour) -> None:
     from matplotlib.lines import Line2D
 
     from jaxcelt.plotting.orbits import BIFURCATION_MARKERS, _runs
@@ -57,13 +79,16 @@ def _branch_panel(ax, res) -> None:
         psi = np.degrees(res.options.brute_psi0)
         handles.append(Line2D([], [], ls="", marker="o", ms=4, color="0.6",
                               label=f"brute force: section points from rest, ψ₀ = {psi:g}°"))  # fmt: skip
-    colours = ("#08519c", "#ff7f0e", "#2ca02c", "#e377c2", "#8c564b", "#17becf")
+    spare = ("#08519c", "#ff7f0e", "#2ca02c", "#e377c2", "#8c564b", "#17becf")
+    owners = getattr(res, "branch_attractors", None) or [-1] * len(res.branches)
+    ys_all: list[np.ndarray] = []
     placed: list[tuple[float, float]] = []
     marked = set()
     ylo, yhi = ax.get_ylim() if res.brute is not None else (0.0, 1.0)
-    for n, (label, br) in enumerate(res.branches):
-        c = colours[n % len(colours)]
+    for n, ((label, br), owner) in enumerate(zip(res.branches, owners, strict=True)):
+        c = colour[owner] if owner >= 0 else spare[n % len(spare)]  # the colour of its attractor in (b), (c)
         lam, y = np.asarray(br.values), np.asarray(br.y)[:, 4]
+        ys_all.append(y)
         for a, b, stable in _runs(np.asarray(br.stable)):
             ax.plot(lam[a : b + 1], y[a : b + 1], ls="-" if stable else "--", lw=2.0 if stable else 1.3, color=c,
                     zorder=3)  # fmt: skip
@@ -74,6 +99,7 @@ def _branch_panel(ax, res) -> None:
             ax.plot([bif.value], [yb], ls="", marker=m, ms=8, mfc=mc, mec="k", zorder=5)
             marked.add(bif.kind)
             placed.append((float(bif.value), yb, short))
+    _clip(ax, res, ys_all)
     # labels of the bifurcation points: one per (kind, value) (a mirror pair shares them), stacked, not overlapping
     seen: dict[tuple[str, str], list[float]] = {}
     for v, yb, short in placed:
@@ -166,9 +192,15 @@ def atlas_figure(res: Any, *, title: str = ""):
     ds = res.continuation
     colour = dict(enumerate(_palette(ds.sizes["attractor"])))
     fig, axes = plt.subplots(3, 1, figsize=(13, 11), sharex=True, gridspec_kw=dict(height_ratios=[1.5, 1, 1]))
-    _branch_panel(axes[0], res)
+    _branch_panel(axes[0], res, colour)
     _fraction_panel(axes[1], res, colour)
     _lyapunov_panel(axes[2], res, colour)
+    for w_read in READ_OFF:  # the paper's frequencies, where the section is read off
+        if res.values[0] <= w_read <= res.values[-1]:
+            for ax in axes:
+                ax.axvline(w_read, color="0.35", lw=0.8, ls=":", zorder=0)
+            axes[0].text(w_read, 0.985, f"{w_read:g}", transform=axes[0].get_xaxis_transform(), ha="center",
+                         va="top", fontsize=8, color="0.3", bbox=dict(fc="white", ec="none", pad=0.5))  # fmt: skip
     for ax, letter in zip(axes, "abc", strict=True):
         ax.text(-0.07, 1.0, f"({letter})", transform=ax.transAxes, fontsize=12, fontweight="bold", va="top")
     w = res.values

@@ -51,25 +51,28 @@ class AtlasOptions:
         max_branches: branches at most.
         spectrum_periods: periods of `jaxcelt.lyapunov_spectrum` per attractor and value (0: off).
         spectrum_transient: its transient periods (the tangent frame aligns).
+        spectrum_rtol: its relative tolerance (atol = rtol / 100); the finite-time error of the exponents
+            (about 1 / (spectrum_periods T)) dominates the solver's at 1e-8.
         out: directory of the continuation's resumable files (None: nothing written).
         progress: progress bars.
     """
 
-    starts: tuple[int, int] = (8, 4)
+    starts: tuple[int, int] = (8, 3)
     tilt: float = 0.1
     transient_periods: int = 100
     sample_periods: int = 16
-    lyapunov_periods: int = 50
+    lyapunov_periods: int = 40
     seeds_per_attractor: int = 4
-    brute_values: int = 101
-    brute_transient: int = 150
-    brute_sample: int = 32
+    brute_values: int = 51
+    brute_transient: int = 100
+    brute_sample: int = 24
     brute_psi0: float = float(np.radians(157.5))
     branches: bool = True
     branch_max_points: int = 120
     max_branches: int = 4
     spectrum_periods: int = 0
     spectrum_transient: int = 10
+    spectrum_rtol: float = 1e-8
     out: str | None = None
     progress: bool = False
 
@@ -90,6 +93,8 @@ class AtlasOptions:
                 raise ValueError(f"AtlasOptions: '{f}' must be a positive integer, got {v!r}")
         if self.sample_periods < 2:
             raise ValueError(f"AtlasOptions: 'sample_periods' must be >= 2, got {self.sample_periods!r}")
+        if not (np.isfinite(self.spectrum_rtol) and 0 < self.spectrum_rtol < 1):
+            raise ValueError(f"AtlasOptions: 'spectrum_rtol' must be in (0, 1), got {self.spectrum_rtol!r}")
         if not np.isfinite(self.brute_psi0):
             raise ValueError(f"AtlasOptions: 'brute_psi0' must be finite, got {self.brute_psi0!r}")
         object.__setattr__(self, "starts", (int(s[0]), int(s[1])))
@@ -106,6 +111,7 @@ class AtlasResult:
         continuation: the `jaxcelt.continue_attractors` dataset (attractor x value).
         branches: list of (label, `jaxcelt.orbits.branch.ArclengthBranch`), each with ``stable`` along it and its
             ``bifurcations`` (kind, value, y).
+        branch_attractors: per branch, the id of the continuation's attractor whose orbit lies on it (-1: none).
         lambda1, lambda1_stderr, lambda2, lambda2_stderr: (attractor, value) exponents [1/s] from
             `jaxcelt.lyapunov_spectrum` at the representative section point (NaN where absent or not computed).
         seconds: wall time of each part [s] (first calls include compilation).
@@ -117,6 +123,7 @@ class AtlasResult:
     brute: Any
     continuation: Any
     branches: list
+    branch_attractors: list
     lambda1: np.ndarray
     lambda1_stderr: np.ndarray
     lambda2: np.ndarray
@@ -137,9 +144,9 @@ class AtlasResult:
                 a["spectrum"] = [_num(self.lambda1[i, j]), _num(self.lambda2[i, j])]
                 a["spectrum_stderr"] = [_num(self.lambda1_stderr[i, j]), _num(self.lambda2_stderr[i, j])]
         branches = []
-        for label, br in self.branches:
+        for (label, br), a in zip(self.branches, self.branch_attractors, strict=True):
             d = branch_to_dict(br, STATE_NAMES)
-            branches.append(dict(label=label, n_points=len(br.values), stopped=br.stopped,
+            branches.append(dict(label=label, attractor=a, n_points=len(br.values), stopped=br.stopped,
                                  bifurcations=[dict(kind=b.kind, value=float(b.value)) for b in br.bifurcations],
                                  branch=d))  # fmt: skip
         brute = None
@@ -207,9 +214,14 @@ def atlas(params: CeltParams, values: Any, *, options: AtlasOptions | None = Non
         seconds["brute_force"] = round(time.perf_counter() - t, 2)
 
     branches: list = []
+    owners: list = []
     if o.branches:
         t = time.perf_counter()
         branches = _branches(params, ds, window, o)
+        seeds = orbit_seeds(ds)
+        for _, br in branches:
+            on = [a for a, j, _ in seeds if _on_branch(br, float(vals[j]), ds["orbit_point"].values[a, j])]
+            owners.append(on[0] if on else -1)
         seconds["branches"] = round(time.perf_counter() - t, 2)
 
     shape = (ds.sizes["attractor"], vals.size)
@@ -218,7 +230,7 @@ def atlas(params: CeltParams, values: Any, *, options: AtlasOptions | None = Non
         t = time.perf_counter()
         lam = _spectra(params, ds, o)
         seconds["spectrum"] = round(time.perf_counter() - t, 2)
-    return AtlasResult(params, vals, brute, ds, branches, *lam, seconds, o)
+    return AtlasResult(params, vals, brute, ds, branches, owners, *lam, seconds, o)
 
 
 def orbit_seeds(ds) -> list[tuple[int, int, int]]:
@@ -344,7 +356,8 @@ def _spectra(params: CeltParams, ds, o: AtlasOptions) -> list[np.ndarray]:
 
     def one(w, y):
         p = eqx.tree_at(lambda q: q.omega_pi, params, w)  # a traced value: no validation (values checked above)
-        return celt_lyapunov_spectrum(p, y, periods=o.spectrum_periods, transient_periods=o.spectrum_transient)
+        return celt_lyapunov_spectrum(p, y, periods=o.spectrum_periods, transient_periods=o.spectrum_transient,
+                                      rtol=o.spectrum_rtol, atol=o.spectrum_rtol / 100)  # fmt: skip
 
     r = jax.vmap(one)(jnp.asarray(vals[idx[:, 1]]), jnp.asarray(pts[idx[:, 0], idx[:, 1]]))
     good = np.asarray(r.status) == 0
