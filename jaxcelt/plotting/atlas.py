@@ -174,6 +174,13 @@ def _lyapunov_panel(ax, res, colour) -> None:
                         marker="o", ms=4, lw=1, capsize=2)  # fmt: skip
         handles.append(Line2D([], [], color=colour[a], marker="o", label=f"#{a}"))
     ax.axhline(0.0, color="k", lw=0.8)
+    # the range of the exponents themselves: a short window's large error bar must not squash the others
+    lam = np.r_[res.lambda1.ravel(), res.lambda2.ravel()] if has_spec else ds["lyapunov"].values.ravel()
+    lam = lam[np.isfinite(lam)]
+    if lam.size:
+        lo, hi = min(float(lam.min()), 0.0), max(float(lam.max()), 0.0)
+        pad = 0.25 * max(hi - lo, 0.2)
+        ax.set_ylim(lo - pad, hi + pad)
     if has_spec:
         handles += [Line2D([], [], color="k", marker="o", ls="-", label="λ₁"),
                     Line2D([], [], color="k", marker="s", mfc="white", ls=":", label="λ₂")]  # fmt: skip
