@@ -166,3 +166,24 @@ def test_branches_fold_and_mirror():
     y0 = np.interp(15.5, *zip(*sorted(zip(b0.values, np.asarray(b0.y)[:, 4]), key=lambda t: t[0])))
     y1 = np.interp(15.5, *zip(*sorted(zip(b1.values, np.asarray(b1.y)[:, 4]), key=lambda t: t[0])))
     assert abs(y0 + y1) < 0.02 * max(abs(y0), 0.1)
+
+
+def test_half_turn_is_the_symmetry_relabelling():
+    """`half_turn` equals the half-turn relabelling derived in tests/test_symmetry.py (Q = diag(-1, -1, 1),
+    M = I, psi read off the turned axes) on a tilted, spinning state; applied twice it is the identity.
+    Tolerance 1e-12 (rounding of psi + pi)."""
+    from test_symmetry import transform_state
+
+    from jaxcelt.sweeps.atlas import half_turn
+
+    p = jc.CeltParams.paper()
+    n = np.array([0.05, -0.03, 1.0]) / np.linalg.norm([0.05, -0.03, 1.0])
+    y = np.asarray(jc.initial_state(p, psi=0.7, omega=(0.3, -0.2, 1.1), n=n))
+    expected = transform_state(y, (-1, -1, 1), (1, 1, 1))
+    got = half_turn(y)
+    d = got - expected
+    d[12] = np.mod(d[12] + np.pi, 2 * np.pi) - np.pi
+    assert np.max(np.abs(d)) < 1e-12
+    back = half_turn(got) - y
+    back[12] = np.mod(back[12] + np.pi, 2 * np.pi) - np.pi
+    assert np.max(np.abs(back)) < 1e-12
