@@ -190,4 +190,5 @@ SETTINGS = [
     (PAGE, "14.8798 rad/s at q_π = 0.04 m"),
     (PAGE, "its Neimark–Sacker point (17.7475 rad/s)"),
     (PAGE, "exceed 2× its steps"),
+    (PAGE, "(ω_π = 17 rad/s, q_π = 0.01 m, from rest)"),
 ]
