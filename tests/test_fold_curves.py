@@ -68,3 +68,16 @@ def test_grouped_fields_must_agree_and_bounds_name_the_parameter():
     p = jc.CeltParams.paper(omega_pi=14.88)
     with pytest.raises(ValueError, match="'q_pi' = 0.04 lies outside"):
         jc.continue_orbit_bifurcation(p, np.zeros(13), ("omega_pi", "q_pi"), ((10.0, 20.0), (0.05, 0.06)))
+
+
+def test_the_wobblestone_curve_reuses_its_compiled_stepper_for_the_same_stone():
+    # continue_bifurcation keeps its compiled stepper keyed on args_of: the wrapper hands back the same function for
+    # the same stone (other start values of the two continued fields), another for another stone
+    from jaxcelt.orbits.celt_curves import _args_of
+
+    p = jc.CeltParams.paper()
+    a = _args_of(p.replace(omega_pi=14.88), ("omega_pi",), ("q_pi",))
+    assert a is _args_of(p.replace(omega_pi=14.9, q_pi=0.041), ("omega_pi",), ("q_pi",))
+    other = _args_of(p.replace(mu=0.2), ("omega_pi",), ("q_pi",))
+    assert other is not a
+    assert float(a(15.0, 0.05).q_pi) == 0.05 and float(other(15.0, 0.05).mu) == 0.2

@@ -5,6 +5,8 @@ chart of the contact manifold."""
 from __future__ import annotations
 
 import dataclasses
+import functools
+from collections.abc import Callable
 from typing import Unpack
 
 import diffrax
@@ -44,6 +46,33 @@ def _curve_fields(params: CeltParams, name) -> tuple[str, ...]:
             f"({', '.join(f'{f} = {float(getattr(params, f)):g}' for f in fields)})"
         )
     return fields
+
+
+def _args_of(params: CeltParams, f1: tuple[str, ...], f2: tuple[str, ...]) -> Callable:
+    """``(p1, p2) -> params`` with the fields ``f1`` set to p1 and ``f2`` to p2. The same function object comes back
+    for the same stone (equal values of the other fields), so that `continue_bifurcation`'s compiled stepper,
+    keyed on it, is reused by the next call rather than compiled again (a call costs minutes of compilation)."""
+    others = tuple(
+        (f.name, np.asarray(getattr(params, f.name)).tobytes())
+        for f in dataclasses.fields(params)
+        if f.name not in f1 + f2
+    )
+    fn, stone = _args_of_cached(others, f1, f2)
+    stone.setdefault("params", params)  # any stone of this key: the fields that differ are the ones args_of sets
+    return fn
+
+
+@functools.lru_cache(maxsize=16)
+def _args_of_cached(key: tuple, f1: tuple[str, ...], f2: tuple[str, ...]) -> tuple[Callable, dict]:
+    """A cache of `_args_of`'s functions, keyed on the other fields' values (bytes): 16 stones at most."""
+    fields = f1 + f2
+    stone: dict = {}
+
+    def args_of(p1, p2):
+        values = [jnp.asarray(p1, float)] * len(f1) + [jnp.asarray(p2, float)] * len(f2)
+        return eqx.tree_at(lambda p: [getattr(p, f) for f in fields], stone["params"], values)
+
+    return args_of, stone
 
 
 def continue_orbit_bifurcation(
@@ -120,16 +149,10 @@ def continue_orbit_bifurcation(
             )
     check_state(y_guess, params, name="y_guess", tol=GUESS_MANIFOLD_TOL)
     opts = resolve_options(options, CURVE_DEFAULTS, caller="continue_orbit_bifurcation", **settings)
-    fields = f1 + f2
-
-    def args_of(p1, p2):
-        values = [jnp.asarray(p1, float)] * len(f1) + [jnp.asarray(p2, float)] * len(f2)
-        return eqx.tree_at(lambda p: [getattr(p, f) for f in fields], params, values)
-
     return continue_bifurcation(
         CeltField(get_contact_law(contact_law)),
         jnp.asarray(y_guess, float),
-        args_of,
+        _args_of(params, f1, f2),
         _period,
         start,
         ((float(b[0, 0]), float(b[0, 1])), (float(b[1, 0]), float(b[1, 1]))),
