@@ -61,7 +61,11 @@ CURVES = {
     "B12": ("B12", (-2e-4, 2e-4), 1e-4, -1, 0.2, 0.5, 9),
     "derivative_exact": ("derivative_exact", (0.0, 1.0), 0.5, +1, 0.2, 0.5, 9),
     "k_r": ("k_r", (0.0, 1.2), 0.1, 0, 0.2, 1.0, 9),
+    # the B12 curve stopped at its point limit at B12 = 5.2e-5: continued from that end towards 0
+    "B12_to_0": ("B12", (-2e-4, 2e-4), 1e-4, -1, 0.3, 0.5, 7),
 }
+START_FROM = {"B12_to_0": "B12"}
+"""a curve started from the lowest-parameter end of another (read from its part file beside ``--part``)"""
 
 
 def crossing(omega: np.ndarray, p: np.ndarray, level: float = OMEGA_PAPER) -> list[dict]:
@@ -82,10 +86,15 @@ def crossing(omega: np.ndarray, p: np.ndarray, level: float = OMEGA_PAPER) -> li
     return out
 
 
-def run_curve(key: str) -> dict:
+def run_curve(key: str, part: pathlib.Path) -> dict:
     name, bounds, scale, direction, ds, ds_max, max_points = CURVES[key]
     y, w = fold_start()
     p = jc.CeltParams.paper(omega_pi=w)
+    if key in START_FROM:
+        cd = json.loads(part.with_name(START_FROM[key] + ".json").read_text())["curves"][START_FROM[key]]["curve"]
+        j = int(np.argmin(cd[name]))
+        y, w = np.asarray(cd["state"][j]), float(cd["omega_pi"][j])
+        p = _params(name, float(cd[name][j]), w)
     p0 = float(getattr(p, name))
     times: list[float] = []
     t0 = time.perf_counter()
@@ -112,7 +121,8 @@ def run_curve(key: str) -> dict:
         "ds_max": ds_max,
         "max_points": max_points,
         "points": len(om),
-        "start_minus_located_fold": float(om[i0] - located_fold()),
+        "start_minus_located_fold": float(om[i0] - located_fold()) if key not in START_FROM else None,
+        "continues": START_FROM.get(key),
         "range_reached": [float(pp.min()), float(pp.max())],
         "omega_range": [float(om.min()), float(om.max())],
         "domega_dp_at_start": float((om[b] - om[a]) / (pp[b] - pp[a])) if b > a and pp[b] != pp[a] else None,
@@ -130,8 +140,6 @@ PERIODS = 300
 """forcing periods of the motion run from an orbit to judge its global motion"""
 DRIFT_THRESHOLD = 0.05
 """[m] net displacement of O that counts as unbounded wandering (`jaxcelt.sweeps.regimes.classify`'s default)"""
-END_VALUES = {"B12": 0.0, "derivative_exact": 1.0}
-"""the far end of each move for the 15.6 rad/s orbit (B12 = 0: half way to -B12, whose stone is the mirror image)"""
 
 
 def _params(name: str, value: float, omega: float) -> jc.CeltParams:
@@ -175,6 +183,10 @@ def global_motion(params: jc.CeltParams, y0: np.ndarray, periods: int = PERIODS)
         "left_orbit_at_period": int(np.argmax(dev > 1e-3)) if np.any(dev > 1e-3) else None,
         "seconds_incl_compile": round(time.perf_counter() - t, 1),
     }
+
+
+STEPS_156 = 6
+"""natural-parameter steps from the paper's value to the moved one for the 15.6 rad/s orbit"""
 
 
 def _orbit_record(params, o) -> dict:
@@ -227,7 +239,7 @@ def sheets_at_14(name: str, cd: dict, seg: int) -> dict:
 
 def orbit_156(name: str, end: float) -> dict:
     """The stable 15.6 rad/s orbit (docs/orbits/branches.json) at the paper's values and continued in ``name``
-    to ``end`` (`jc.continue_orbit` at omega_pi = 15.6): its multipliers and global motion at both ends."""
+    to ``end`` in `STEPS_156` natural-parameter steps of `jc.periodic_orbit` at omega_pi = 15.6: its multipliers and global motion at both ends."""
     d = json.loads((ROOT / "docs/orbits/branches.json").read_text())
     br = next(iter(d["branches"].values()))["branch"]
     v = np.asarray(br["values"])
@@ -243,16 +255,20 @@ def orbit_156(name: str, end: float) -> dict:
         "end_value": end,
         "default": {**_orbit_record(p, o), "motion": global_motion(p, np.asarray(o.y))},
     }
-    b2 = jc.continue_orbit(p, o, name, end, ds=0.05 * abs(end - float(getattr(p, name)) or 1),
-                           ds_max=0.3 * abs(end - float(getattr(p, name)) or 1), max_points=40, max_steps=MAX_STEPS)  # fmt: skip
-    vals = np.asarray(b2.values)
-    k = int(np.argmin(np.abs(vals - end)))
-    pe = _params(name, float(vals[k]), float(v[i]))
-    oe = jc.periodic_orbit(_params(name, end, float(v[i])), np.asarray(b2.y[k]), max_steps=MAX_STEPS)
-    out["branch"] = {name: vals.tolist(), "stable": np.asarray(b2.stable).tolist()}
-    out["end"] = {**_orbit_record(pe, oe)}
-    if int(oe.status) == 0:
-        out["end"]["motion"] = global_motion(_params(name, end, float(v[i])), np.asarray(oe.y))
+    p0, path, ok = float(getattr(p, name.split("=")[0])), [], True
+    for val in np.linspace(p0, end, STEPS_156 + 1)[1:]:  # natural-parameter steps, each from the previous orbit
+        pe = _params(name, float(val), float(v[i]))
+        o2 = jc.periodic_orbit(pe, np.asarray(o.y), max_steps=MAX_STEPS)
+        ok = int(o2.status) == 0
+        path.append({name: float(val), "status": int(o2.status), "stable": bool(o2.stable),
+                     "max_abs_multiplier": float(np.max(np.abs(np.asarray(o2.multipliers))))})  # fmt: skip
+        if not ok:
+            break
+        o = o2
+    out["path"] = path
+    out["end"] = _orbit_record(pe, o2)
+    if ok:
+        out["end"]["motion"] = global_motion(pe, np.asarray(o2.y))
     out["seconds_incl_compile"] = round(time.perf_counter() - t, 1)
     return out
 
@@ -321,19 +337,19 @@ def main(argv=None) -> int:
     ap.add_argument("--part", type=pathlib.Path, help="where --curve writes its curve")
     ap.add_argument("--merge", nargs="*", type=pathlib.Path, default=[])
     ap.add_argument("--at14", nargs=2, metavar=("CURVE", "SEGMENT"), help="sheets at 14 rad/s from a curve's crossing")
-    ap.add_argument("--at156", choices=list(END_VALUES), help="the 15.6 rad/s orbit moved to the end of a reading")
+    ap.add_argument("--at156", nargs=2, metavar=("PARAMETER", "VALUE"), help="the 15.6 rad/s orbit moved to VALUE")
     ap.add_argument("--plot-only", action="store_true")
     ap.add_argument("--out", type=pathlib.Path, default=OUT)
     a = ap.parse_args(argv)
     if a.curve:
         load0 = list(os.getloadavg())
-        part = {"curves": {a.curve: run_curve(a.curve)}, "load_average_start": load0}
+        part = {"curves": {a.curve: run_curve(a.curve, a.part)}, "load_average_start": load0}
         part["load_average_end"] = list(os.getloadavg())
         a.part.write_text(json.dumps(part, indent=1))
         return 0
     if a.at156:
         load0 = list(os.getloadavg())
-        part = {"at_15_6": {a.at156: orbit_156(a.at156, END_VALUES[a.at156])}, "load_average_start": load0}
+        part = {"at_15_6": {a.at156[0]: orbit_156(a.at156[0], float(a.at156[1]))}, "load_average_start": load0}
         a.part.write_text(json.dumps(part, indent=1))
         return 0
     if a.at14:
