@@ -199,18 +199,18 @@ def _orbit_record(params, o) -> dict:
     }
 
 
-def sheets_at_14(name: str, cd: dict, seg: int) -> dict:
+def sheets_at_14(name: str, cd: dict, seg: int, offset: float = 0.02) -> dict:
     """Both orbits born at the fold, at omega_pi = 14: at fixed parameter value p of the curve point of segment
-    ``seg`` whose fold lies below 14 rad/s, `jc.continue_orbit` in omega_pi from just above that fold through it
+    ``seg`` whose fold lies below 14 rad/s, `jc.continue_orbit` in omega_pi from ``offset`` above that fold through it
     (both sheets) up to 14.05 rad/s; each sheet's point nearest 14 is polished by `jc.periodic_orbit` at exactly
     14 rad/s, and the motion from it is run `PERIODS` periods."""
     om = cd["omega_pi"]
     j = seg if om[seg] < OMEGA_PAPER else seg + 1
     wf, pv, y = float(om[j]), float(cd[name][j]), np.asarray(cd["state"][j])
     t = time.perf_counter()
-    p = _params(name, pv, wf + 0.02)
+    p = _params(name, pv, wf + offset)
     o = jc.periodic_orbit(p, y, max_steps=MAX_STEPS)
-    out = {"curve_point": j, "fold_omega": wf, name: pv, "start_status": int(o.status)}
+    out = {"curve_point": j, "fold_omega": wf, name: pv, "start_offset": offset, "start_status": int(o.status)}
     if int(o.status) != 0:
         return out
     br = jc.continue_orbit(p, o, "omega_pi", (wf - 0.3, OMEGA_PAPER + 0.05), ds=0.02, ds_max=0.15, max_points=60,
@@ -273,6 +273,58 @@ def orbit_156(name: str, end: float) -> dict:
     return out
 
 
+GRAD_FIELDS = ("B12", "derivative_exact", "k_r", "q_pi", "mu")
+"""the fields d omega_fold / d theta is taken in by the implicit function theorem (one reverse pass)"""
+
+
+def fold_gradient() -> dict:
+    """d omega_fold / d theta at the paper's values for every field of `GRAD_FIELDS` at once: `jax.grad` of
+    `jaxcelt.orbits.celt.locate_orbit_bifurcation`'s located value, as scripts/celt_fold_grad.py does for mu alone
+    (that script's file records mu only, so the directions of the other readings are computed here)."""
+    import equinox as eqx
+    import jax
+    import jax.numpy as jnp
+
+    from jaxcelt.orbits.celt import locate_orbit_bifurcation
+
+    y, v = fold_start()
+    p = jc.CeltParams.paper(omega_pi=v)
+
+    def fold(vals):
+        q = eqx.tree_at(lambda q: [getattr(q, f) for f in GRAD_FIELDS], p, list(vals))
+        return locate_orbit_bifurcation(q, y, "omega_pi", v, kind="fold", wrt=GRAD_FIELDS).value
+
+    t = time.perf_counter()
+    g = jax.grad(fold)([jnp.asarray(float(getattr(p, f))) for f in GRAD_FIELDS])
+    return {
+        "domega_fold_d": {f: float(x) for f, x in zip(GRAD_FIELDS, g, strict=True)},
+        "seconds_incl_compile": round(time.perf_counter() - t, 1),
+    }
+
+
+def walk_at_14(key: str, steps: int = 8, to: float | None = None) -> dict:
+    """The stable sheet found at 14 rad/s by ``--at14`` (at_14 part ``key``) followed in its parameter towards the
+    paper's value at omega_pi = 14 in natural steps of `jc.periodic_orbit` (each from the previous orbit) up to the
+    other end of the curve's crossing segment (or to ``to``): if the orbit is the one born at the fold, it ends (or turns
+    unstable through a multiplier at +1) where the fold crosses 14 rad/s."""
+    part = json.loads(pathlib.Path(key).read_text())
+    a = next(iter(part["at_14"].values()))
+    name = a["parameter"]
+    s = next(s for s in a["sheets_at_14"] if s["stable"])
+    src = json.loads(pathlib.Path(key).with_name(a["curve"] + ".json").read_text())["curves"][a["curve"]]["curve"]
+    (x,) = crossing(src["omega_pi"], src[name])
+    hi = float(src[name][x["segment"] + 1]) if to is None else to
+    y, path = np.asarray(s["state"]), []
+    for val in np.linspace(a[name], hi, steps + 1)[1:]:
+        o = jc.periodic_orbit(_params(name, float(val), OMEGA_PAPER), y, max_steps=MAX_STEPS)
+        path.append({name: float(val), "status": int(o.status), "stable": bool(o.stable),
+                     "multipliers_abs": [float(m) for m in np.abs(np.asarray(o.multipliers))[:3]]})  # fmt: skip
+        if int(o.status) != 0:
+            break
+        y = np.asarray(o.y)
+    return {"from": a[name], "to": hi, "crossing": x["p"], "path": path}
+
+
 def summarise(res: dict) -> None:
     """Per curve: its crossings of 14 rad/s, lowest fold and slope at the paper's value; per orbit check: stable or
     saddle at 14 rad/s and the global motion; and the plain answer."""
@@ -307,15 +359,24 @@ def plot(res: dict, path: pathlib.Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    keys = list(res["curves"])
+    keys = [k for k in res["curves"] if k not in START_FROM]
     fig, axes = plt.subplots(1, max(len(keys), 1), figsize=(4.2 * max(len(keys), 1), 3.8), squeeze=False)
     for ax, key in zip(axes[0], keys, strict=False):
         c = res["curves"][key]
-        name, cd = c["parameter"], c["curve"]
-        ax.plot(cd["omega_pi"], cd[name], ".-", lw=1, ms=3, color="C0", label="fold curve")
+        name = c["parameter"]
+        parts = [res["curves"][k]["curve"] for k in res["curves"] if k == key or START_FROM.get(k) == key]
+        w = np.concatenate([cd["omega_pi"] for cd in parts])
+        pv = np.concatenate([cd[name] for cd in parts])
+        order = np.argsort(pv)
+        ax.plot(w[order], pv[order], ".-", lw=1, ms=3, color="C0", label="fold curve")
         if name == "B12":  # the mirror half: omega_fold(B12) = omega_fold(-B12)
-            ax.plot(cd["omega_pi"], -np.asarray(cd[name]), ".--", lw=1, ms=3, color="C0", alpha=0.5,
-                    label="mirror image (−B12)")  # fmt: skip
+            ax.plot(w[order], -pv[order], ".--", lw=1, ms=3, color="C0", alpha=0.5, label="mirror image (−B12)")
+        for a in res.get("at_14", {}).values():
+            if a["parameter"] == name:
+                for sh in a.get("sheets_at_14", []):
+                    ax.plot([OMEGA_PAPER], [a[name]], "o" if sh["stable"] else "x", color="g" if sh["stable"] else "m",
+                            mfc="none", ms=8, label="stable orbit at 14" if sh["stable"] else "saddle at 14")  # fmt: skip
+        cd = c["curve"]
         ax.plot([res["located_fold_omega"]], [c["paper_value"]], "r*", ms=10, label="paper's reading")
         ax.axvline(OMEGA_PAPER, color="k", ls="--", lw=0.8, label="ω_π = 14 rad/s")
         for pt in cd["points"]:
@@ -337,6 +398,11 @@ def main(argv=None) -> int:
     ap.add_argument("--part", type=pathlib.Path, help="where --curve writes its curve")
     ap.add_argument("--merge", nargs="*", type=pathlib.Path, default=[])
     ap.add_argument("--at14", nargs=2, metavar=("CURVE", "SEGMENT"), help="sheets at 14 rad/s from a curve's crossing")
+    ap.add_argument("--grad", action="store_true", help="d omega_fold / d theta by the implicit function theorem")
+    ap.add_argument("--walk", type=pathlib.Path, help="an --at14 part whose stable sheet is followed to the crossing")
+    ap.add_argument("--walk-to", type=float, help="--walk: the end value (default: past the crossing)")
+    ap.add_argument("--walk-steps", type=int, default=8)
+    ap.add_argument("--offset", type=float, default=0.02, help="--at14: start this far above the fold [rad/s]")
     ap.add_argument("--at156", nargs=2, metavar=("PARAMETER", "VALUE"), help="the 15.6 rad/s orbit moved to VALUE")
     ap.add_argument("--plot-only", action="store_true")
     ap.add_argument("--out", type=pathlib.Path, default=OUT)
@@ -346,6 +412,19 @@ def main(argv=None) -> int:
         part = {"curves": {a.curve: run_curve(a.curve, a.part)}, "load_average_start": load0}
         part["load_average_end"] = list(os.getloadavg())
         a.part.write_text(json.dumps(part, indent=1))
+        return 0
+    if a.walk:
+        a.part.write_text(
+            json.dumps(
+                {
+                    "walk_at_14": walk_at_14(str(a.walk), a.walk_steps, a.walk_to),
+                    "load_average_start": list(os.getloadavg()),
+                }
+            )
+        )
+        return 0
+    if a.grad:
+        a.part.write_text(json.dumps({"gradient": fold_gradient(), "load_average_start": list(os.getloadavg())}))
         return 0
     if a.at156:
         load0 = list(os.getloadavg())
@@ -359,7 +438,7 @@ def main(argv=None) -> int:
         if key not in src:
             src = json.loads(a.part.with_name(key + ".json").read_text())["curves"]
         name = src[key]["parameter"]
-        part = {"at_14": {f"{key}:{seg}": {"curve": key, "parameter": name, **sheets_at_14(name, src[key]["curve"], seg)}},
+        part = {"at_14": {f"{key}:{seg}:{a.offset:g}": {"curve": key, "parameter": name, **sheets_at_14(name, src[key]["curve"], seg, a.offset)}},
                 "load_average_start": load0}  # fmt: skip
         a.part.write_text(json.dumps(part, indent=1))
         return 0
@@ -368,11 +447,17 @@ def main(argv=None) -> int:
     if a.merge:
         load0 = None
         res.setdefault("curves", {})
+        res.pop("walk_at_14", None)
+        res["walks_at_14"] = []
         for f in a.merge:
             part = json.loads(f.read_text())
             load0 = load0 or part["load_average_start"]
             for k in ("curves", "at_14", "at_15_6"):
                 res.setdefault(k, {}).update(part.get(k, {}))
+            if "walk_at_14" in part:
+                res.setdefault("walks_at_14", []).append(part["walk_at_14"])
+            if "gradient" in part:
+                res["gradient_at_paper_values"] = part["gradient"]
         res.update(
             system="paper's stone (CeltParams.paper), fold of the period-1 family of the 15.6 rad/s orbit",
             omega_bounds=list(OMEGA_BOUNDS), max_steps=MAX_STEPS, periods_run=PERIODS,

@@ -38,3 +38,22 @@ def test_crossing_none_touch_and_bad_input():
     assert [c["p"] for c in crossing([15.0, 14.0], [0.0, 1.0])] == [1.0]
     with pytest.raises(ValueError, match="omega"):
         crossing([1.0, 2.0], [1.0])
+
+
+@pytest.mark.slow
+def test_stable_orbit_at_14_recomputed():
+    # the stable sheet at 14 rad/s of docs/orbits/paper_14.json, solved again by jc.periodic_orbit from its recorded
+    # state: the same orbit to the Newton tolerance (state within 1e-7) and the same multiplier moduli to 1e-6
+    # (the variational solve at rtol 1e-11 reproduces them far better; 1e-6 leaves room for another machine's
+    # floating point), stable as recorded
+    import jaxcelt as jc
+    from paper_14 import _params
+
+    res = json.loads((ROOT / "docs/orbits/paper_14.json").read_text())
+    a, s = next((a, s) for a in res["at_14"].values() for s in a["sheets_at_14"] if s["stable"])
+    name = a["parameter"]
+    o = jc.periodic_orbit(_params(name, a[name], 14.0), np.asarray(s["state"]), max_steps=20_000)
+    assert int(o.status) == 0
+    assert np.max(np.abs(np.asarray(o.y) - np.asarray(s["state"]))) < 1e-7
+    assert np.abs(np.asarray(o.multipliers)) == pytest.approx(s["multipliers_abs"], abs=1e-6)
+    assert bool(o.stable)
