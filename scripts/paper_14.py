@@ -20,14 +20,23 @@ depends on time, so s_pi = -1 is the same system shifted by half a forcing perio
 same fold), and a real s_pi between is the amplitude s_pi q_pi, i.e. the (omega_pi, q_pi) curve of fold_curves.json;
 at s_pi = 0 there is no forcing at all.
 
-Each curve runs as its own process (``--curve KEY --part FILE``) and the parts are merged (``--merge``); then
-``--orbits`` solves the period-1 orbit at 14 rad/s wherever a curve crosses it (multipliers) and runs the motion
-from it over a few hundred periods (drift of O), and does the same for the 15.6 rad/s orbit at the curves' ends.
-Timings are indicative (load average recorded; each process compiles its own corrector).
+Every computation runs as its own process writing a part file (``--part``), and the parts are merged (``--merge``):
+``--curve KEY`` follows one fold curve (``B12_to_0`` continues the B12 curve from its end); ``--grad`` takes
+d omega_fold / d theta by the implicit function theorem; ``--at14 CURVE SEGMENT`` solves the orbits at 14 rad/s
+past a curve's crossing (a curve of this script's parts or of docs/orbits/fold_curves.json) and runs the motion
+from each for `PERIODS` periods (drift of O); ``--walk PART`` follows the stable orbit of an ``--at14`` part in its
+parameter at 14 rad/s; ``--at156 PARAMETER VALUE`` moves the 15.6 rad/s orbit and runs it likewise. Timings are
+indicative (load average recorded; each process compiles its own solver). The committed file was made by
 
-    python scripts/paper_14.py --curve B12 --part /tmp/p14_B12.json
-    python scripts/paper_14.py --merge /tmp/p14_*.json
-    python scripts/paper_14.py --orbits
+    python scripts/paper_14.py --curve B12 --part /tmp/p14/B12.json   # also derivative_exact, k_r, then B12_to_0
+    python scripts/paper_14.py --grad --part /tmp/p14/grad.json
+    python scripts/paper_14.py --at14 q_pi_upper2 5 --part /tmp/p14/at14_q_pi.json
+    python scripts/paper_14.py --at14 B12 2 --offset 0.004 --part /tmp/p14/at14_B12_b.json
+    python scripts/paper_14.py --at14 B12 1 --part /tmp/p14/at14_B12_c.json
+    python scripts/paper_14.py --walk /tmp/p14/at14_B12_c.json --walk-to 1.728e-4 --walk-steps 12 --part /tmp/p14/walk2.json
+    python scripts/paper_14.py --at156 q_pi 0.04599119520882185 --part /tmp/p14/at156_q_pi.json
+    python scripts/paper_14.py --at156 B12 8.611814330421657e-05 --part /tmp/p14/at156_B12.json
+    python scripts/paper_14.py --merge /tmp/p14/{B12,B12_to_0,derivative_exact,k_r,at14_q_pi,at14_B12_b,at14_B12_c,at156_q_pi,at156_B12,grad,walk2}.json
     python scripts/paper_14.py --plot-only
 """
 
@@ -53,7 +62,6 @@ from fold_curves import MAX_STEPS, OMEGA_BOUNDS, fold_start, located_fold  # noq
 
 OUT = ROOT / "docs/orbits/paper_14.json"
 OMEGA_PAPER = 14.0
-B12_PAPER = 1.728e-4
 
 # key -> (parameter, bounds, scale, direction (+1/-1 towards increasing/decreasing parameter, 0 both), ds, ds_max,
 # points at most)

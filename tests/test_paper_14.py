@@ -46,8 +46,9 @@ def test_stable_orbit_at_14_recomputed():
     # state: the same orbit to the Newton tolerance (state within 1e-7) and the same multiplier moduli to 1e-6
     # (the variational solve at rtol 1e-11 reproduces them far better; 1e-6 leaves room for another machine's
     # floating point), stable as recorded
-    import jaxcelt as jc
     from paper_14 import _params
+
+    import jaxcelt as jc
 
     res = json.loads((ROOT / "docs/orbits/paper_14.json").read_text())
     a, s = next((a, s) for a in res["at_14"].values() for s in a["sheets_at_14"] if s["stable"])
