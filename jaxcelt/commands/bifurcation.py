@@ -65,6 +65,13 @@ def register(sub) -> None:
     p.add_argument("--orbit-periods", type=positive_int, default=40, help="periods shown in the phase plots")
     p.add_argument("--out", type=Path, default=Path("out/bifurcation"), help="output directory (resumable)")
     p.add_argument("--no-figures", action="store_true")
+    p.add_argument(
+        "--atlas",
+        action="store_true",
+        help="also draw the atlas over omega_pi (`jaxcelt atlas` at its default size, into OUT/atlas/: attractors, "
+        "basin fractions, periodic branches, exponents) and start each phase plot on the attractor with the largest "
+        "basin there, rather than from rest",
+    )
     p.set_defaults(func=run)
 
 
@@ -153,6 +160,8 @@ def run(args) -> int:
         raise UsageError("argument --omega/--values: no values to sweep")
     for v in values:  # each lane's parameters must be valid too
         params.replace(**{args.param: float(v)})
+    if args.atlas and (args.param != "omega_pi" or set(overrides(args.set)) - {"q_pi"}):
+        raise UsageError("argument --atlas: the atlas is over omega_pi at the paper's parameters (--set q_pi=... only)")
     omega0 = args.omega0
     print(versions_string(), flush=True)
     y0 = np.asarray(jc.initial_state(params, omega=omega0))
@@ -201,8 +210,12 @@ def run(args) -> int:
         "regimes": regime_runs(ds),
     }
     write_result(args.out / "summary.json", summary, load_at_start=load)
+    starts = {}
+    if args.atlas:
+        starts = _atlas(args, params)
+        summary["atlas"] = {"dir": "atlas", "phase_plot_starts": {f"{w:g}": v[1] for w, v in starts.items()}}
     if not args.no_figures:
-        _figures(args, ds, params, omega0, solver)
+        _figures(args, ds, params, omega0, solver, starts)
     # the whole command after its imports: the sweep, the figures and the phase plots, compilation included
     summary["command_seconds"] = round(time.perf_counter() - t_command, 2)
     write_result(args.out / "summary.json", summary, load_at_start=load)
@@ -219,7 +232,39 @@ def _orbit_settings(args, solver) -> dict:
     return dict(transient_periods=args.transient, periods=args.orbit_periods, solver=solver, rtol=args.rtol, atol=args.atol)
 
 
-def _figures(args, ds, params, omega0, solver) -> None:
+def _atlas(args, params) -> dict:
+    """`jaxcelt atlas` at its default size (at this stone's q_pi) into OUT/atlas; for each phase-plot frequency
+    that is one of its values, (the state of the attractor with the largest basin there, a label for it)."""
+    import numpy as np
+    import xarray as xr
+
+    from jaxcelt.commands import atlas as atlas_command
+
+    parser = argparse.ArgumentParser()
+    atlas_command.register(parser.add_subparsers())
+    a = parser.parse_args(["atlas", "--out", str(args.out / "atlas"), "--q-pi", repr(float(params.q_pi))])
+    atlas_command.run(a)
+    starts = {}
+    with xr.open_dataset(args.out / "atlas" / "atlas.nc") as ds:
+        vals = ds["omega_pi"].values
+        for w in np.asarray(args.orbits, dtype=float):
+            j = np.flatnonzero(np.abs(vals - w) < 1e-9)
+            if j.size == 0:
+                continue
+            frac = np.where(ds["exists"].values[:, j[0]].astype(bool), ds["fraction"].values[:, j[0]], -1.0)
+            i = int(np.argmax(frac))
+            if frac[i] <= 0:
+                starts[float(w)] = (None, "no attractor in the atlas: every start tipped over (shown from rest)")
+                continue
+            kind = str(ds["kind"].values[i, j[0]])
+            period = int(ds["period"].values[i, j[0]])
+            name = f"period-{period}" if kind == "periodic" and period > 0 else kind
+            y = np.asarray(ds["section_point"].values[i, j[0]], dtype=float)
+            starts[float(w)] = (y, f"attractor #{int(ds['attractor'].values[i])} of the atlas ({name}, basin {frac[i]:.2f})")
+    return starts
+
+
+def _figures(args, ds, params, omega0, solver, starts=None) -> None:
     import matplotlib
     import numpy as np
 
@@ -246,8 +291,13 @@ def _figures(args, ds, params, omega0, solver) -> None:
     if phase_plots:
         for w in args.orbits:
             pw = params.replace(omega_pi=float(w))
-            o = dense_trajectory(pw, jc.initial_state(pw, omega=omega0), **orbit_settings)
-            label = "" if o["valid"] else "model left its validity (lift-off or n3 <= 0)"
+            y_att, att_label = (starts or {}).get(float(w), (None, ""))
+            # an attractor's section state drifts off the contact manifold by the integration error: projected back
+            y0 = jc.initial_state(pw, omega=omega0) if y_att is None else jc.project_state(y_att, pw)
+            o = dense_trajectory(pw, y0, **orbit_settings)
+            label = att_label if o["valid"] else "; ".join(
+                x for x in (att_label, "model left its validity (lift-off or n3 <= 0)") if x
+            )
             fig = orbit_figure(o["ts"], o["ys"], o["r_O"], o["section_index"], omega_pi=float(w), label=label)
             fig.savefig(args.out / f"orbit_omega{w:g}.png", dpi=130)
             plt.close(fig)

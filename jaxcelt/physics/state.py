@@ -149,6 +149,7 @@ def project_state(y: State, params: CeltParams) -> State:
     Normalises n, removes the normal component of the contact-point velocity v_A = v + omega x rho
     (eq. 2) and sets r_C3 to the height of C above the contact (-rho . n). Differentiable.
     """
+    y = jnp.asarray(y)
     v, w, n, r_C, psi = y[0:3], y[3:6], y[6:9], y[9:12], y[12:13]
     n = n / jnp.linalg.norm(n)
     rho = contact_geometry(n, w, params).rho
