@@ -419,25 +419,21 @@ def main(argv=None) -> int:
         load0 = list(os.getloadavg())
         part = {"curves": {a.curve: run_curve(a.curve, a.part)}, "load_average_start": load0}
         part["load_average_end"] = list(os.getloadavg())
-        a.part.write_text(json.dumps(part, indent=1))
+        write_result(a.part, part, load_at_start=load0, indent=1)  # a part: merged by --merge
         return 0
     if a.walk:
-        a.part.write_text(
-            json.dumps(
-                {
-                    "walk_at_14": walk_at_14(str(a.walk), a.walk_steps, a.walk_to),
-                    "load_average_start": list(os.getloadavg()),
-                }
-            )
-        )
+        load0 = list(os.getloadavg())
+        part = {"walk_at_14": walk_at_14(str(a.walk), a.walk_steps, a.walk_to), "load_average_start": load0}
+        write_result(a.part, part, load_at_start=load0, indent=1)
         return 0
     if a.grad:
-        a.part.write_text(json.dumps({"gradient": fold_gradient(), "load_average_start": list(os.getloadavg())}))
+        load0 = list(os.getloadavg())
+        write_result(a.part, {"gradient": fold_gradient(), "load_average_start": load0}, load_at_start=load0, indent=1)
         return 0
     if a.at156:
         load0 = list(os.getloadavg())
         part = {"at_15_6": {a.at156[0]: orbit_156(a.at156[0], float(a.at156[1]))}, "load_average_start": load0}
-        a.part.write_text(json.dumps(part, indent=1))
+        write_result(a.part, part, load_at_start=load0, indent=1)
         return 0
     if a.at14:
         key, seg = a.at14[0], int(a.at14[1])
@@ -448,7 +444,7 @@ def main(argv=None) -> int:
         name = src[key]["parameter"]
         part = {"at_14": {f"{key}:{seg}:{a.offset:g}": {"curve": key, "parameter": name, **sheets_at_14(name, src[key]["curve"], seg, a.offset)}},
                 "load_average_start": load0}  # fmt: skip
-        a.part.write_text(json.dumps(part, indent=1))
+        write_result(a.part, part, load_at_start=load0, indent=1)
         return 0
     res = json.loads(a.out.read_text()) if a.out.exists() else {}
     res.pop("provenance", None)
