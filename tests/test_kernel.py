@@ -16,7 +16,7 @@ import pytest
 
 import jaxcelt as jc
 from jaxcelt.ensemble import BLOCK, SweepConfig, blockwise, lanes_params, run_lanes
-from jaxcelt.ensemble.kernel import KERNEL_FIELDS, make_segment
+from jaxcelt.ensemble.kernel import make_segment
 from jaxcelt.ensemble.soa import as_blocks, from_blocks
 from jaxcelt.physics.contact.registry import get_contact_law
 from jaxcelt.physics.model import vector_field_and_normal
@@ -115,27 +115,10 @@ def test_float32_field_time_keeps_the_forcing_phase():
     np.testing.assert_allclose(np.sin(om * np.asarray(tau, np.float64)), np.sin(om * np.asarray(t)), atol=2e-6)
 
 
-def test_kernel_lowers_for_cuda_without_a_gpu():
+def test_kernel_lowers_for_cuda_without_a_gpu(kernel_cuda_text):
     # the kernel is built for a GPU by Pallas' Triton backend; lowering it needs no GPU and fails
     # on any operation that backend cannot lower
-    pb, _ = _grid_lanes(1)
-    cfg = SweepConfig(stop_on_invalid=True)
-    leaves, treedef = jax.tree_util.tree_flatten(P)
-    names = [path[-1].name for path, _ in jax.tree_util.tree_flatten_with_path(P)[0]]
-    vary = [n in ("omega_pi", "q_pi") for n in names]
-    consts = [np.asarray(x).item() for x in leaves]
-
-    def params_of(pv):
-        it = iter(pv)
-        return jax.tree_util.tree_unflatten(treedef, [next(it) if v else c for v, c in zip(vary, consts)])
-
-    seg = make_segment(cfg, params_of, 2)
-    L = 2 * BLOCK
-    z, zi = jnp.zeros(L), jnp.zeros(L, jnp.int32)
-    flat = [z] * 26 + [zi if k in ("num_steps", "code", "first_invalid_kind", "stiff", "stiff_count", "stiff_steps") else z for k in KERNEL_FIELDS]
-    lowered = jax.jit(lambda flat, tg, pv: seg(flat, tg, tg, tg, pv, False)).trace(flat, z, (z, z))
-    text = lowered.lower(lowering_platforms=("cuda",)).as_text()
-    assert "triton" in text
+    assert "triton" in kernel_cuda_text(SweepConfig(stop_on_invalid=True))
 
 
 def test_engine_is_checked():

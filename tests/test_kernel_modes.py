@@ -17,8 +17,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import jaxcelt as jc
-from jaxcelt.ensemble import BLOCK, SweepConfig, lanes_params, run_lanes
-from jaxcelt.ensemble.kernel import KERNEL_FIELDS, make_segment
+from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
 from jaxcelt.ensemble.kernel_ode import solve_lanes
 from jaxcelt.ensemble.rosenbrock import RODAS4P, lu_factor, lu_solve
 
@@ -99,24 +98,8 @@ def test_lu_solve_matches_numpy():
 
 
 @pytest.mark.parametrize("mode", [dict(stiffness="auto"), dict(field_dtype="float32", rtol=1e-6, atol=1e-8)])
-def test_kernel_modes_lower_for_cuda_without_a_gpu(mode):
-    cfg = SweepConfig(stop_on_invalid=True, **mode)
-    leaves, treedef = jax.tree_util.tree_flatten(P)
-    names = [path[-1].name for path, _ in jax.tree_util.tree_flatten_with_path(P)[0]]
-    vary = [n in ("omega_pi", "q_pi") for n in names]
-    consts = [np.asarray(x).item() for x in leaves]
-
-    def params_of(pv):
-        it = iter(pv)
-        return jax.tree_util.tree_unflatten(treedef, [next(it) if v else c for v, c in zip(vary, consts)])
-
-    seg = make_segment(cfg, params_of, 2)
-    L = 2 * BLOCK
-    z, zi = jnp.zeros(L), jnp.zeros(L, jnp.int32)
-    ints = ("num_steps", "code", "first_invalid_kind", "stiff", "stiff_count", "stiff_steps")
-    flat = [z] * 26 + [zi if k in ints else z for k in KERNEL_FIELDS]
-    lowered = jax.jit(lambda flat, tg, pv: seg(flat, tg, tg, tg, pv, False)).trace(flat, z, (z, z))
-    assert "triton" in lowered.lower(lowering_platforms=("cuda",)).as_text()
+def test_kernel_modes_lower_for_cuda_without_a_gpu(mode, kernel_cuda_text):
+    assert "triton" in kernel_cuda_text(SweepConfig(stop_on_invalid=True, **mode))
 
 
 def test_mixed_precision_follows_float64():
