@@ -71,6 +71,22 @@ def located_fold() -> float:
     return float(json.loads((ROOT / "docs/orbits/celt_fold_grad.json").read_text())["omega_fold"])
 
 
+def timed_fold_curve(key, p, y, name, bounds, scale, ds, ds_max, max_points, direction):
+    """The fold curve in (omega_pi, ``name``) from (p, y), each point's time printed: (curve, point times, total)."""
+    times: list[float] = []
+    t0 = time.perf_counter()
+
+    def cb(n, v, ok):
+        times.append(time.perf_counter() - t0)
+        print(f"  [{key}] point {n} {name} = {v:.6g} {'ok' if ok else 'retry'} ({times[-1]:.0f} s)", flush=True)
+
+    curve = jc.continue_orbit_bifurcation(
+        p, y, ("omega_pi", name), (OMEGA_BOUNDS, bounds), scale=(1.0, scale), ds=ds, ds_max=ds_max,
+        max_points=max_points, max_steps=MAX_STEPS, callback=cb, direction=direction,
+    )  # fmt: skip
+    return curve, times, time.perf_counter() - t0
+
+
 def run_curve(key: str, res: dict) -> dict:
     name, bounds, scale, ds, ds_max, max_points = CURVES[key]
     y, w = fold_start()
@@ -83,18 +99,7 @@ def run_curve(key: str, res: dict) -> dict:
         p = jc.CeltParams.paper(omega_pi=w, **{f: cd[name][j] for f in name.split("=")})
         direction = START_FROM[key][1]
     p0 = float(getattr(p, name.split("=")[0]))
-    times: list[float] = []
-    t0 = time.perf_counter()
-
-    def cb(n, v, ok):
-        times.append(time.perf_counter() - t0)
-        print(f"  [{key}] point {n} {name} = {v:.6g} {'ok' if ok else 'retry'} ({times[-1]:.0f} s)", flush=True)
-
-    curve = jc.continue_orbit_bifurcation(
-        p, y, ("omega_pi", name), (OMEGA_BOUNDS, bounds), scale=(1.0, scale), ds=ds, ds_max=ds_max,
-        max_points=max_points, max_steps=MAX_STEPS, callback=cb, direction=direction,
-    )  # fmt: skip
-    total = time.perf_counter() - t0
+    curve, times, total = timed_fold_curve(key, p, y, name, bounds, scale, ds, ds_max, max_points, direction)
     d = curve_to_dict(curve, ("omega_pi", name))
     i0 = curve.start
     om = np.asarray(curve.p1)

@@ -58,7 +58,7 @@ from jaxcelt.versions import versions
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "scripts"))
-from fold_curves import MAX_STEPS, OMEGA_BOUNDS, fold_start, located_fold  # noqa: E402
+from fold_curves import MAX_STEPS, OMEGA_BOUNDS, fold_start, located_fold, timed_fold_curve  # noqa: E402
 
 OUT = ROOT / "docs/orbits/paper_14.json"
 OMEGA_PAPER = 14.0
@@ -104,18 +104,7 @@ def run_curve(key: str, part: pathlib.Path) -> dict:
         y, w = np.asarray(cd["state"][j]), float(cd["omega_pi"][j])
         p = _params(name, float(cd[name][j]), w)
     p0 = float(getattr(p, name))
-    times: list[float] = []
-    t0 = time.perf_counter()
-
-    def cb(n, v, ok):
-        times.append(time.perf_counter() - t0)
-        print(f"  [{key}] point {n} {name} = {v:.6g} {'ok' if ok else 'retry'} ({times[-1]:.0f} s)", flush=True)
-
-    curve = jc.continue_orbit_bifurcation(
-        p, y, ("omega_pi", name), (OMEGA_BOUNDS, bounds), scale=(1.0, scale), ds=ds, ds_max=ds_max,
-        max_points=max_points, max_steps=MAX_STEPS, callback=cb, direction=direction,
-    )  # fmt: skip
-    total = time.perf_counter() - t0
+    curve, times, total = timed_fold_curve(key, p, y, name, bounds, scale, ds, ds_max, max_points, direction)
     om, pp = np.asarray(curve.p1), np.asarray(curve.p2)
     i0 = curve.start
     a, b = max(i0 - 1, 0), min(i0 + 1, len(om) - 1)
