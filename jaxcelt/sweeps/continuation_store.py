@@ -112,19 +112,14 @@ class ContinuationStore:
     """One file per parameter value under ``out/values/`` and the run's manifest (see the module docstring)."""
 
     def __init__(self, out, fingerprint: dict) -> None:
-        from jaxcelt.sweeps.dataset import DamagedChunkWarning, _atomic_write_text
+        from jaxcelt.sweeps.dataset import _atomic_write_text, read_manifest
 
         self.dir = Path(out)
         text = json.dumps(fingerprint, sort_keys=True, default=repr)
         self.fingerprint = hashlib.sha256(text.encode()).hexdigest()
         (self.dir / "values").mkdir(parents=True, exist_ok=True)
         mpath = self.dir / "manifest.json"
-        old = None
-        if mpath.exists():
-            try:
-                old = json.loads(mpath.read_text())
-            except (ValueError, OSError) as e:
-                warnings.warn(f"{mpath} is damaged ({e}); rewriting it", DamagedChunkWarning, stacklevel=3)
+        old = read_manifest(mpath)
         if old is not None and old.get("fingerprint") != self.fingerprint:
             raise ValueError(
                 f"out: {self.dir} holds a different continuation (manifest fingerprint differs); "

@@ -52,6 +52,18 @@ class DamagedChunkWarning(RuntimeWarning):
     """A chunk file of an interrupted sweep could not be used on resume; the chunk is recomputed."""
 
 
+def read_manifest(path: Path) -> dict | None:
+    """A resumable run's manifest (JSON), None if there is none; a damaged one is reported with a
+    `DamagedChunkWarning` and treated as absent (the caller rewrites it)."""
+    if not path.exists():
+        return None
+    try:
+        return json.loads(path.read_text())
+    except (ValueError, OSError) as e:
+        warnings.warn(f"{path} is damaged ({e}); rewriting it", DamagedChunkWarning, stacklevel=4)
+        return None
+
+
 _RENAME = {"samples": "section", "t_samples": "t_section"}
 _DOCS = {
     "section": ("state at the stroboscopic times t0 + (transient + k) 2 pi/omega_pi", "SI (see state)"),
@@ -235,12 +247,7 @@ class SweepWriter:
         manifest["fingerprint"] = self.fingerprint
         (self.dir / "chunks").mkdir(parents=True, exist_ok=True)
         mpath = self.dir / "manifest.json"
-        old = None
-        if mpath.exists():
-            try:
-                old = json.loads(mpath.read_text())
-            except (ValueError, OSError) as e:  # torn manifest: the chunk files carry the fingerprint too
-                warnings.warn(f"{mpath} is damaged ({e}); rewriting it", DamagedChunkWarning, stacklevel=3)
+        old = read_manifest(mpath)  # a torn manifest: the chunk files carry the fingerprint too
         if old is not None:
             if old.get("fingerprint") != self.fingerprint:
                 raise ValueError(
