@@ -3,7 +3,8 @@
 (a) brute-force section points omega_2 (grey) with every continued periodic branch on top (stable solid, unstable
 dashed; fold / period-doubling / Neimark-Sacker points marked and labelled); (b) the attractors' basin fractions
 stacked, tipping over in its own colour; (c) lambda_1 and lambda_2 of every attractor (error bars: their standard
-errors), with the zero line.
+errors), with the zero line; lambda_1's marker is the label from the spectrum (`AtlasResult.kind_spectrum`: a
+2-torus, a sink, chaos, or uncertain), its colour the attractor's.
 """
 
 from __future__ import annotations
@@ -16,6 +17,13 @@ import numpy as np
 __all__ = ["plot_atlas", "atlas_figure"]
 
 _TIPPING = "#d62728"
+SPECTRUM_MARKERS = {
+    "chaotic": ("^", "chaotic: λ₁ > 0"),
+    "quasi-periodic": ("D", "2-torus: λ₁ ≈ 0, λ₂ < 0"),
+    "converging": ("v", "sink (periodic orbit): λ₁ < 0"),
+    "uncertain": ("X", "uncertain: near-NS focus, 3-torus, or too short"),
+}
+"""marker and legend text of lambda_1 per label from the spectrum (`jaxcelt.sweeps.regimes.spectrum_regime`)"""
 READ_OFF = (14.0, 15.6, 17.0, 19.0)
 """the paper's frequencies [rad/s], marked by dotted lines"""
 
@@ -156,7 +164,9 @@ def _lyapunov_panel(ax, res, colour) -> None:
     n_att = ds.sizes["attractor"]
     dx = 0.012 * (w[-1] - w[0]) if len(w) > 1 else 0.0
     has_spec = np.isfinite(res.lambda1).any()
+    kinds = getattr(res, "kind_spectrum", None)
     handles = []
+    shown: set[str] = set()
     for a in range(n_att):
         ex = ds["exists"].values[a]
         if not ex.any():
@@ -166,8 +176,16 @@ def _lyapunov_panel(ax, res, colour) -> None:
             for lam, err, m, ls in ((res.lambda1, res.lambda1_stderr, "o", "-"), (res.lambda2, res.lambda2_stderr,
                                                                                  "s", ":")):  # fmt: skip
                 y = np.where(ex, lam[a], np.nan)
-                ax.errorbar(w + off, y, yerr=np.where(ex, err[a], np.nan), color=colour[a], marker=m, ms=4, ls=ls,
-                            lw=1, capsize=2, mfc=colour[a] if m == "o" else "white")  # fmt: skip
+                by_kind = m == "o" and kinds is not None
+                ax.errorbar(w + off, y, yerr=np.where(ex, err[a], np.nan), color=colour[a], marker="" if by_kind else m,
+                            ms=4, ls=ls, lw=1, capsize=2, mfc=colour[a] if m == "o" else "white")  # fmt: skip
+                if by_kind:  # lambda_1's marker: the label from the spectrum
+                    for kind, (mk, _) in SPECTRUM_MARKERS.items():
+                        sel = ex & (kinds[a] == kind) & np.isfinite(y)
+                        if sel.any():
+                            ax.plot((w + off)[sel], y[sel], ls="", marker=mk, ms=6, color=colour[a], mec="k",
+                                    mew=0.5, zorder=4)  # fmt: skip
+                            shown.add(kind)
         else:
             y = np.where(ex, ds["lyapunov"].values[a], np.nan)
             ax.errorbar(w + off, y, yerr=np.where(ex, ds["lyapunov_stderr"].values[a], np.nan), color=colour[a],
@@ -182,8 +200,10 @@ def _lyapunov_panel(ax, res, colour) -> None:
         pad = 0.25 * max(hi - lo, 0.2)
         ax.set_ylim(lo - pad, hi + pad)
     if has_spec:
-        handles += [Line2D([], [], color="k", marker="o", ls="-", label="λ₁"),
+        handles += [Line2D([], [], color="k", marker="" if shown else "o", ls="-", label="λ₁"),
                     Line2D([], [], color="k", marker="s", mfc="white", ls=":", label="λ₂")]  # fmt: skip
+        handles += [Line2D([], [], color="0.6", mec="k", mew=0.5, marker=mk, ls="", ms=6, label=f"λ₁ marker, {text}")
+                    for kind, (mk, text) in SPECTRUM_MARKERS.items() if kind in shown]  # fmt: skip
         sp = res.options.spectrum_periods
         ax.set_ylabel(f"λ₁, λ₂ [1/s]\n(spectrum, {sp} periods)")
     else:

@@ -13,7 +13,10 @@
    solve and not continued again;
 4. the **Lyapunov exponents** of every attractor at every value: lambda_1 (and its standard error) from the
    continuation's lanes (``lyapunov_periods > 0``) and, with ``spectrum_periods > 0``, lambda_1 and lambda_2 from
-   `jaxcelt.lyapunov_spectrum` started at the attractor's representative section point (one vmapped batch).
+   `jaxcelt.lyapunov_spectrum` started at the attractor's representative section point (one vmapped batch), and
+   from them a label per attractor and value (`AtlasResult.kind_spectrum`, `jaxcelt.sweeps.regimes.spectrum_regime`
+   with the continuation's thresholds): lambda_1 ~ 0 with lambda_2 clearly negative is a 2-torus
+   (quasi-periodic), lambda_1 ~ lambda_2 ~ 0 uncertain (a focus near a Neimark-Sacker point, or a 3-torus).
 
 The result is an `AtlasResult` (plain arrays, the continuation's `xarray.Dataset`, the branches); `AtlasResult.summary`
 is its JSON-ready form. Drawing it is `jaxcelt.plotting.atlas.plot_atlas`; the command line is ``jaxcelt atlas``.
@@ -29,7 +32,7 @@ import numpy as np
 
 from jaxcelt.physics.params import CeltParams
 
-__all__ = ["AtlasOptions", "AtlasResult", "atlas"]
+__all__ = ["AtlasOptions", "AtlasResult", "atlas", "spectrum_kinds"]
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
@@ -116,6 +119,10 @@ class AtlasResult:
             `jaxcelt.lyapunov_spectrum` at the representative section point (NaN where absent or not computed).
         seconds: wall time of each part [s] (first calls include compilation).
         options: the `AtlasOptions` used.
+        kind_spectrum: (attractor, value) label from lambda_1 and lambda_2 (`spectrum_kinds`): ``"chaotic"``,
+            ``"converging"`` (a sink: a periodic orbit, reached or not), ``"quasi-periodic"`` (a 2-torus) or
+            ``"uncertain"``; ``""`` where there is no spectrum. None at construction: computed from the exponents
+            with the continuation's ``chaos_threshold`` and ``confidence``.
     """
 
     params: CeltParams
@@ -130,6 +137,13 @@ class AtlasResult:
     lambda2_stderr: np.ndarray
     seconds: dict
     options: AtlasOptions
+    kind_spectrum: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.kind_spectrum is None:
+            rule = _rule(self.continuation)
+            kinds = spectrum_kinds(self.lambda1, self.lambda1_stderr, self.lambda2, self.lambda2_stderr, **rule)
+            object.__setattr__(self, "kind_spectrum", kinds)
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready: the continuation summary, the branches with their bifurcation points, the exponents."""
@@ -143,6 +157,7 @@ class AtlasResult:
                 i = a["id"]
                 a["spectrum"] = [_num(self.lambda1[i, j]), _num(self.lambda2[i, j])]
                 a["spectrum_stderr"] = [_num(self.lambda1_stderr[i, j]), _num(self.lambda2_stderr[i, j])]
+                a["kind_spectrum"] = str(self.kind_spectrum[i, j]) or None
         branches = []
         for (label, br), a in zip(self.branches, self.branch_attractors, strict=True):
             d = branch_to_dict(br, STATE_NAMES)
@@ -155,6 +170,33 @@ class AtlasResult:
         return dict(options=dataclasses.asdict(self.options), params={k: float(v) for k, v in
                     dataclasses.asdict(self.params).items() if np.ndim(v) == 0}, continuation=cont,
                     branches=branches, brute_force=brute, seconds=self.seconds)  # fmt: skip
+
+
+def spectrum_kinds(
+    lambda1, lambda1_stderr, lambda2, lambda2_stderr, *, chaos_threshold: float = 0.02, confidence: float = 2.0
+) -> np.ndarray:
+    """Labels (object array of str, the inputs' shape) from lambda_1, lambda_2 and their standard errors [1/s]:
+    the `REGIMES` names of `jaxcelt.sweeps.regimes.spectrum_regime`, ``""`` where lambda_1 is missing (NaN)."""
+    from jaxcelt.sweeps.regimes import REGIMES, spectrum_regime
+
+    code = spectrum_regime(lambda1, lambda1_stderr, lambda2, lambda2_stderr, chaos_threshold=chaos_threshold,
+                           confidence=confidence)  # fmt: skip
+    out = np.empty(code.shape, dtype=object)
+    for idx in np.ndindex(code.shape):
+        out[idx] = "" if code[idx] == 5 else REGIMES[int(code[idx])]
+    return out
+
+
+def _rule(ds) -> dict[str, float]:
+    """The continuation's exponent thresholds (``chaos_threshold``, ``confidence``; the defaults if not recorded)."""
+    import json
+
+    from jaxcelt.sweeps.continuation_options import ContinuationOptions
+
+    d = ContinuationOptions()
+    rec = json.loads(getattr(ds, "attrs", {}).get("options_json", "{}"))
+    return dict(chaos_threshold=float(rec.get("chaos_threshold", d.chaos_threshold)),
+                confidence=float(rec.get("confidence", d.confidence)))  # fmt: skip
 
 
 def _num(x) -> float | None:

@@ -5,8 +5,8 @@ Euclidean space where distances mean something (for the wobblestone (v, omega, n
 cyclic position r_C left out; for a plain ODE the state itself). No model, no integration: numpy only.
 
 * `lane_kinds`: per lane, periodic with period k (`jaxcelt.sweeps.regimes.detect_period`), else a
-  non-periodic kind from the largest Lyapunov exponent when there is one (the rule of
-  `jaxcelt.sweeps.regimes.classify`), else ``aperiodic``; lanes that left the model's validity or whose
+  non-periodic kind from the largest Lyapunov exponent when there is one (and from lambda_2 too when given:
+  `jaxcelt.sweeps.regimes.spectrum_regime`, the rule of `jaxcelt.sweeps.regimes.classify`), else ``aperiodic``; lanes that left the model's validity or whose
   solve failed are outcomes, not attractors.
 * `cycle_distance`, `set_distance`, `spacing`: how far two periodic cycles (up to a cyclic shift) or two
   point sets are apart.
@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from jaxcelt.sweeps.regimes import detect_period
+from jaxcelt.sweeps.regimes import REGIMES, detect_period, spectrum_regime
 
 __all__ = [
     "KINDS",
@@ -53,16 +53,27 @@ def lane_kinds(
     period_tol: float,
     chaos_threshold: float,
     confidence: float,
+    lyapunov_2: np.ndarray | None = None,
+    lyapunov_2_stderr: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Kind code (index into `KINDS`; -1 tipping over, -2 failed) and period k (0 unless periodic) per lane.
 
     Args:
         coords: (L, S, m) section coordinates of the samples; outcome: (L,) 0 ran, 1 left validity, 2 failed;
         lyapunov, lyapunov_stderr: (L,) [1/s] or None (not computed; NaN entries count as not computed).
+        lyapunov_2, lyapunov_2_stderr: (L,) the second exponent [1/s] and its error, or None (not computed): with
+            it a lambda_1 near 0 is quasi-periodic only if lambda_2 is clearly negative (`spectrum_regime`).
+        chaos_threshold, confidence: the exponent rule (`jaxcelt.sweeps.regimes.spectrum_regime`).
     """
     L, S = coords.shape[:2]
     kind = np.zeros(L, np.int64)
     period = np.zeros(L, np.int64)
+    nan = np.full(L, np.nan)
+    se = None if lyapunov_stderr is None else np.asarray(lyapunov_stderr, dtype=float)
+    code = spectrum_regime(
+        nan if lyapunov is None else lyapunov, None if se is None else np.where(np.isfinite(se), se, 0.0),
+        lyapunov_2, lyapunov_2_stderr, chaos_threshold=chaos_threshold, confidence=confidence,
+    )  # fmt: skip
     for i in range(L):
         if outcome[i] == 1:
             kind[i] = TIPPING
@@ -71,22 +82,10 @@ def lane_kinds(
             kind[i] = FAILED
             continue
         k = detect_period(coords[i], max_period=S // 2, tol=period_tol)
-        ly = np.nan if lyapunov is None else float(lyapunov[i])
-        se = 0.0 if lyapunov_stderr is None or not np.isfinite(lyapunov_stderr[i]) else float(lyapunov_stderr[i])
         if k > 0:
             kind[i], period[i] = 0, k
-        elif not np.isfinite(ly):
-            kind[i] = KINDS.index("aperiodic")
         else:
-            lo, hi = ly - confidence * se, ly + confidence * se
-            if lo > chaos_threshold:
-                kind[i] = KINDS.index("chaotic")
-            elif hi < -chaos_threshold:
-                kind[i] = KINDS.index("converging")
-            elif lo >= -chaos_threshold and hi <= chaos_threshold:
-                kind[i] = KINDS.index("quasi-periodic")
-            else:
-                kind[i] = KINDS.index("uncertain")
+            kind[i] = KINDS.index(REGIMES[int(code[i])])
     return kind, period
 
 
@@ -219,3 +218,39 @@ def match_attractors(distance: np.ndarray, seed_share: np.ndarray, *, match_tol:
         out[a] = b
         pairs = [p for p in pairs if p[1] != a and p[2] != b]
     return out
+
+
+def contraction_onto(coords: np.ndarray, orbit: np.ndarray, k: int) -> tuple[float, float]:
+    """How the lanes of a set approach a periodic orbit: (median over lanes of the ratio of their mean distance
+    to the orbit in the last quarter of their samples to that in the first quarter, median relative distance in
+    the last quarter).
+
+    Args:
+        coords: (n, S, m) section coordinates of the set's lanes; orbit: (m,) one section point of a period-k
+            orbit. Every k-th sample of a lane near the orbit comes back near this point: of the k phases, the
+            one nearest to it at the end is compared.
+
+    A ratio below 1 says the lanes close in on the orbit (a stable orbit with multipliers near the unit circle
+    draws them in by about max|mu| per period, too slowly to settle within a short transient).
+    """
+    n, S = coords.shape[:2]
+    k = max(int(k), 1)
+    ratios, last = [], []
+    for i in range(n):
+        d = np.linalg.norm(coords[i] - orbit, axis=-1)
+        best = None
+        for r in range(min(k, S)):
+            sub = d[r::k]
+            if sub.size < 4:
+                continue
+            q = max(sub.size // 4, 1)
+            end, start = float(np.mean(sub[-q:])), float(np.mean(sub[:q]))
+            if best is None or end < best[0]:
+                best = (end, start)
+        if best is None or not np.isfinite(best[0]) or best[1] <= 0:
+            continue
+        ratios.append(best[0] / best[1])
+        last.append(best[0] / _scale(coords[i], orbit[None]))
+    if not ratios:
+        return math.inf, math.inf
+    return float(np.median(ratios)), float(np.median(last))

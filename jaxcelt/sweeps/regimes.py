@@ -27,6 +27,10 @@ with psi determine the dynamics; r_C does not feed back):
     integrate the exponent over more periods;
   - ``aperiodic``      -- no exponent was computed.
 
+  With the second exponent lambda_2 and its standard error (``lyapunov_2``, ``lyapunov_2_stderr``) the
+  quasi-periodic label asks more: see `spectrum_regime` (lambda_1 indistinguishable from 0 *and* lambda_2
+  clearly negative: a 2-torus; lambda_2 near 0 too: uncertain).
+
 Global label: ``unbounded`` when O's net horizontal displacement over the samples exceeds
 ``drift_threshold`` [m] and is at least half of its maximum excursion (steady wandering
 away), else ``bounded``. The thresholds are heuristics; the raw numbers (drift, excursion,
@@ -40,7 +44,16 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["REGIMES", "GLOBAL_MOTION", "detect_period", "classify", "regime_names", "regime_ranges", "regime_runs"]
+__all__ = [
+    "REGIMES",
+    "GLOBAL_MOTION",
+    "detect_period",
+    "spectrum_regime",
+    "classify",
+    "regime_names",
+    "regime_ranges",
+    "regime_runs",
+]
 
 REGIMES: dict[int, str] = {
     0: "failed",
@@ -77,6 +90,84 @@ def detect_period(x: np.ndarray, *, max_period: int = 16, tol: float = 1e-4) -> 
     return 0
 
 
+def _check_rule(where: str, chaos_threshold: float, confidence: float) -> None:
+    if not (np.isfinite(chaos_threshold) and chaos_threshold >= 0):
+        raise ValueError(f"{where}: 'chaos_threshold' must be finite and >= 0, got {chaos_threshold!r}")
+    if not (np.isfinite(confidence) and confidence >= 0):
+        raise ValueError(f"{where}: 'confidence' must be finite and >= 0, got {confidence!r}")
+
+
+def _floats(x, shape_of=None) -> np.ndarray:
+    if x is None:
+        return np.full(np.shape(shape_of), np.nan)
+    return np.asarray(x, dtype=float)
+
+
+def spectrum_regime(
+    lambda1,
+    stderr1=None,
+    lambda2=None,
+    stderr2=None,
+    *,
+    chaos_threshold: float = 0.02,
+    confidence: float = 2.0,
+) -> np.ndarray:
+    """`REGIMES` code of a non-periodic motion from its Lyapunov exponents: the one rule of `classify` and
+    `jaxcelt.sweeps.continuation_match.lane_kinds` (vectorised, any broadcastable shapes).
+
+    The wobblestone on the vibrating base is a periodically *forced* system: time is no state variable, so the
+    spectrum of its stroboscopic section has no zero exponent from the flow direction. Counted that way,
+
+    * a stable periodic orbit has every exponent < 0 (a complex Floquet pair mu gives lambda_1 = lambda_2 =
+      log|mu| / T; near a Neimark-Sacker point |mu| -> 1, so both tend to 0: a slowly attracting focus);
+    * a 2-torus (quasi-periodic motion, born at a Neimark-Sacker point) has lambda_1 = 0, lambda_2 < 0;
+    * a 3-torus has lambda_1 = lambda_2 = 0, lambda_3 < 0;
+    * chaos has lambda_1 > 0 (hyperchaos lambda_2 > 0 too).
+
+    With the intervals [lo_i, hi_i] = lambda_i -+ ``confidence`` stderr_i and th = ``chaos_threshold`` [1/s]:
+
+    * ``chaotic`` (4)        -- lo_1 > th;
+    * ``converging`` (6)     -- hi_1 < -th: every perturbation shrinks, a sink (a periodic orbit);
+    * ``quasi-periodic`` (3) -- lambda_1's interval inside [-th, th] and hi_2 < -th: a 2-torus;
+    * ``uncertain`` (7)      -- lambda_1's interval inside [-th, th] but lambda_2 not clearly negative: a focus
+      near a Neimark-Sacker point or a 3-torus, which lambda_1 and lambda_2 alone cannot tell apart (lambda_3,
+      or the Floquet multipliers of a periodic orbit found by Newton, can); or lambda_1's interval reaches
+      across +-th: the window was too short to tell;
+    * ``aperiodic`` (5)      -- lambda_1 is missing (NaN): no exponent was computed.
+
+    Where lambda_2 is missing (None or NaN) the rule is lambda_1's alone, as before lambda_2 existed: an
+    interval inside [-th, th] is ``quasi-periodic``.
+
+    Args:
+        lambda1, lambda2: exponents [1/s] (lambda2 None: not computed).
+        stderr1, stderr2: their standard errors [1/s] (None or NaN: no error known, the point estimate decides).
+        chaos_threshold: th [1/s]; a finite-time exponent of a torus is O(1/t) from 0, hence a band.
+        confidence: half-width of the intervals in standard errors.
+
+    Returns:
+        int32 array of `REGIMES` codes (3, 4, 5, 6 or 7), the broadcast shape of the inputs.
+
+    Raises:
+        ValueError: ``chaos_threshold`` or ``confidence`` not finite and >= 0.
+    """
+    _check_rule("spectrum_regime", chaos_threshold, confidence)
+    l1 = _floats(lambda1)
+    l1, s1, l2, s2 = np.broadcast_arrays(l1, _floats(stderr1, l1), _floats(lambda2, l1), _floats(stderr2, l1))
+    s1, s2 = np.where(np.isnan(s1), 0.0, s1), np.where(np.isnan(s2), 0.0, s2)
+    th = chaos_threshold
+    with np.errstate(invalid="ignore"):
+        lo1, hi1 = l1 - confidence * s1, l1 + confidence * s1
+        hi2 = l2 + confidence * s2
+        inside = (lo1 >= -th) & (hi1 <= th)
+        torus = np.where(np.isnan(l2), True, hi2 < -th)  # no lambda_2: lambda_1's rule alone
+        out = np.full(l1.shape, 7, dtype=np.int32)
+        out[inside & torus] = 3
+        out[hi1 < -th] = 6
+        out[lo1 > th] = 4
+    out[~np.isfinite(l1)] = 5
+    return out
+
+
 def classify(
     samples: np.ndarray,
     status: np.ndarray,
@@ -85,6 +176,8 @@ def classify(
     lyapunov: np.ndarray | None = None,
     *,
     lyapunov_stderr: np.ndarray | None = None,
+    lyapunov_2: np.ndarray | None = None,
+    lyapunov_2_stderr: np.ndarray | None = None,
     max_period: int = 16,
     tol: float = 1e-4,
     chaos_threshold: float = 0.02,
@@ -98,6 +191,10 @@ def classify(
         lyapunov: (...) [1/s] or None.
         lyapunov_stderr: (...) standard errors of ``lyapunov`` [1/s], or None (no error known:
             the point estimate decides); NaN entries count as 0.
+        lyapunov_2, lyapunov_2_stderr: (...) the second exponent lambda_2 [1/s] and its standard error, or None
+            (not computed; NaN entries count as not computed). Where lambda_2 is given, a lambda_1
+            indistinguishable from 0 is ``quasi-periodic`` only if lambda_2 is clearly negative (a 2-torus), else
+            ``uncertain`` (`spectrum_regime`); without it the labels are lambda_1's alone.
         max_period, tol: see `detect_period`.
         chaos_threshold: [1/s] an exponent above it is chaos, below minus it a sink; the
             finite-time estimate of a quasi-periodic orbit is O(1/t) from 0.
@@ -114,19 +211,20 @@ def classify(
     st = np.asarray(status).reshape(-1)
     va = np.asarray(valid).reshape(-1)
     ro = np.asarray(r_O).reshape(-1, *np.shape(r_O)[-2:])
-    ly = None if lyapunov is None else np.asarray(lyapunov, dtype=float).reshape(-1)
-    if not (np.isfinite(chaos_threshold) and chaos_threshold >= 0):
-        raise ValueError(f"classify: 'chaos_threshold' must be finite and >= 0, got {chaos_threshold!r}")
-    if not (np.isfinite(confidence) and confidence >= 0):
-        raise ValueError(f"classify: 'confidence' must be finite and >= 0, got {confidence!r}")
-    se = np.zeros(flat.shape[0])
-    if lyapunov_stderr is not None:
-        se = np.asarray(lyapunov_stderr, dtype=float).reshape(-1)
-        se = np.where(np.isnan(se), 0.0, se)
-    regime = np.zeros(flat.shape[0], dtype=np.int32)
-    period = np.zeros(flat.shape[0], dtype=np.int32)
-    glob = np.full(flat.shape[0], -1, dtype=np.int32)
-    for i in range(flat.shape[0]):
+    _check_rule("classify", chaos_threshold, confidence)
+    n = flat.shape[0]
+
+    def lane(x):
+        return None if x is None else np.asarray(x, dtype=float).reshape(-1)
+
+    exponent_code = spectrum_regime(
+        np.full(n, np.nan) if lyapunov is None else lane(lyapunov), lane(lyapunov_stderr), lane(lyapunov_2),
+        lane(lyapunov_2_stderr), chaos_threshold=chaos_threshold, confidence=confidence,
+    )  # fmt: skip
+    regime = np.zeros(n, dtype=np.int32)
+    period = np.zeros(n, dtype=np.int32)
+    glob = np.full(n, -1, dtype=np.int32)
+    for i in range(n):
         if st[i] in (2, 4):  # stopped at its first invalid state (stop_on_invalid), or on its side past validity
             regime[i] = 1
             continue
@@ -138,18 +236,8 @@ def classify(
             regime[i] = 1
         elif k > 0:
             regime[i], period[i] = 2, k
-        elif ly is not None and np.isfinite(ly[i]):
-            lo, hi = ly[i] - confidence * se[i], ly[i] + confidence * se[i]
-            if lo > chaos_threshold:
-                regime[i] = 4
-            elif hi < -chaos_threshold:
-                regime[i] = 6
-            elif lo >= -chaos_threshold and hi <= chaos_threshold:
-                regime[i] = 3
-            else:
-                regime[i] = 7
         else:
-            regime[i] = 5
+            regime[i] = exponent_code[i]  # 5 (aperiodic) where no exponent was computed
         d = ro[i][:, :2] - ro[i][0, :2]
         if np.all(np.isfinite(d)):
             net = float(np.linalg.norm(d[-1]))
