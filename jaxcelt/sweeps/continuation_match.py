@@ -6,8 +6,8 @@ cyclic position r_C left out; for a plain ODE the state itself). No model, no in
 
 * `lane_kinds`: per lane, periodic with period k (`jaxcelt.sweeps.regimes.detect_period`), else a
   non-periodic kind from the largest Lyapunov exponent when there is one (and from lambda_2 too when given:
-  `jaxcelt.sweeps.regimes.spectrum_regime`, the rule of `jaxcelt.sweeps.regimes.classify`), else ``aperiodic``; lanes that left the model's validity or whose
-  solve failed are outcomes, not attractors.
+  `jaxcelt.sweeps.regimes.spectrum_regime`, the rule of `jaxcelt.sweeps.regimes.classify`), else
+  ``aperiodic``; lanes that left the model's validity or whose solve failed are outcomes, not attractors.
 * `cycle_distance`, `set_distance`, `spacing`: how far two periodic cycles (up to a cyclic shift) or two
   point sets are apart.
 * `group_lanes`: the distinct attractors among the lanes at one value: periodic lanes of one period whose
