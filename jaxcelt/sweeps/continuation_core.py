@@ -8,7 +8,10 @@ In the spirit of Attractors.jl's ``AttractorSeedContinueMatch``: at every parame
 2. **attractors** are identified from the section samples (`jaxcelt.sweeps.continuation_match`): periodic
    lanes by their cycle (and refined by Newton with their Floquet multipliers, `SectionModel.refine`),
    quasi-periodic / chaotic / aperiodic lanes by the distance between their sets of section points, with
-   the largest Lyapunov exponent when the lanes computed it; lanes that left the model's validity
+   the largest Lyapunov exponent when the lanes computed it; a set whose lanes close in on a stable orbit
+   continued from p_{i-1} (`jaxcelt.sweeps.continuation_match.contraction_onto`) is that orbit's attractor,
+   not reached yet: ``converging`` (near a Neimark-Sacker point, |mu| -> 1, lanes settle too slowly to be
+   periodic within the transient); lanes that left the model's validity
    ("tipping over") or failed are outcomes of their own;
 3. **basin fractions** count the fresh lanes only (seeds are excluded: they are not a sample of the
    starts), with the binomial standard error sqrt(f (1 - f) / N);
@@ -37,6 +40,7 @@ from jaxcelt.sweeps.continuation_match import (
     OUTCOMES,
     _same_set,
     attractor_distance,
+    contraction_onto,
     group_lanes,
     lane_kinds,
     match_attractors,
@@ -188,6 +192,20 @@ def _one_value(model, o, index, value, starts, seeds, origin, prev, next_id) -> 
                 )
                 if code == 0 and y is not None:
                     cont[b] = (y, int(prev.att_orbit_k[b]), mu)
+    # A set that is not periodic here but whose lanes close in on a stable orbit continued from the previous
+    # value belongs to that orbit, not reached yet (multipliers near the unit circle draw lanes in slowly):
+    # "converging", with the orbit beside it. Chaotic sets (lambda_1 clearly > 0) are left as they are.
+    for a in range(A):
+        if rows["kind"][a] in (0, KINDS.index("chaotic")):
+            continue
+        members = np.flatnonzero(label == a)
+        for b, (y, kb, mub) in cont.items():
+            if not mub < 1.0:
+                continue
+            ratio, dist = contraction_onto(C[members], np.asarray(model.coords(y[None]), float)[0], kb)
+            if ratio < 1.0 and dist <= o.match_tol:
+                rows["kind"][a], rows["ostate"][a] = KINDS.index("converging"), cont[b]
+                break
     match = np.full(A, -1, np.int64)
     if prev is not None and len(prev.att_id) and A:
         B = len(prev.att_id)
