@@ -89,3 +89,42 @@ def test_arclength_passes_both_folds_of_hardening_duffing():
         near = np.abs(lam - w) < 2e-3
         d = np.linalg.norm(pts[near] - a[-1], axis=-1).min()
         assert d < 2e-2
+
+
+def _args_of_w(w):
+    return jnp.stack([C, F, w])
+
+
+def _period_of(a):
+    return 2 * jnp.pi / a[2]
+
+
+def test_second_branch_of_a_family_reuses_its_compiled_programs():
+    """A second branch of the same family (the same functions and settings) takes the jitted start solve and
+    stepper of the first from the cache (no compilation), and, the same programs on the same input, repeats its
+    points to rounding (1e-12: identical programs, identical input)."""
+    from jaxcelt.orbits.branch import _cached_family_programs
+
+    run = lambda: continue_arclength(duffing, jnp.array([0.5, 0.0]), _args_of_w, _period_of, 1.0, 1.3,  # noqa: E731
+                                     ds=0.1, ds_max=0.3, max_points=5, rtol=1e-9, atol=1e-10)  # fmt: skip
+    first = run()
+    before = _cached_family_programs.cache_info()
+    again = run()
+    after = _cached_family_programs.cache_info()
+    assert after.hits == before.hits + 1 and after.misses == before.misses
+    assert len(first.values) == len(again.values) > 1
+    assert np.max(np.abs(first.values - again.values)) < 1e-12 and np.max(np.abs(first.y - again.y)) < 1e-12
+
+
+def test_celt_branches_of_one_stone_share_their_parameter_setter():
+    """`continue_orbit` keys the family's programs on ``args_of``: one function object per stone and field,
+    whatever the start value of that field, and another one for another stone."""
+    import jaxcelt as jc
+    from jaxcelt.orbits.celt import _field_setter
+
+    p = jc.CeltParams.paper()
+    assert _field_setter(p, "omega_pi") is _field_setter(p.replace(omega_pi=17.0), "omega_pi")
+    assert _field_setter(p, "omega_pi") is not _field_setter(p.replace(mu=0.3), "omega_pi")
+    assert _field_setter(p, "omega_pi") is not _field_setter(p, "q_pi")
+    set_w = _field_setter(p.replace(omega_pi=17.0), "omega_pi")
+    assert float(set_w(12.5).omega_pi) == 12.5 and float(set_w(12.5).mu) == float(p.mu)

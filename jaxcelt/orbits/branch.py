@@ -23,6 +23,7 @@ period doubling by `jaxcelt.orbits.switching`; `branch_to_dict` writes a branch 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import warnings
 from collections.abc import Callable
 from typing import Any, NamedTuple, Unpack
@@ -211,6 +212,27 @@ class ArclengthStepper(NamedTuple):
         return cls(tangent, corrector, jax.jit(recentre), jax.jit(observe))
 
 
+@functools.lru_cache(maxsize=16)
+def _cached_family_programs(family: OrbitFamily) -> tuple[Callable, ArclengthStepper]:
+    cold = dataclasses.replace(family.options, newton_max_steps=_COLD_NEWTON_STEPS)
+    first = jax.jit(lambda lam, y0: family.solve(lam, y0, cold))
+    return first, ArclengthStepper.build(
+        family.residual, family.recentre, family.multipliers, newton_tol=family.options.newton_tol,
+        newton_max_steps=family.options.newton_max_steps,
+    )  # fmt: skip
+
+
+def _family_programs(family: OrbitFamily) -> tuple[Callable, ArclengthStepper]:
+    """The jitted start solve and stepper of ``family``, kept for the next branch of the same family (the same
+    functions and settings, e.g. the mirror branch or another start of the same stone), which then runs without
+    compiling again; built afresh where a field is unhashable."""
+    try:
+        hash(family)
+    except TypeError:
+        return _cached_family_programs.__wrapped__(family)
+    return _cached_family_programs(family)
+
+
 def trace_arclength(
     stepper: ArclengthStepper,
     u0: Array,
@@ -339,15 +361,7 @@ def continue_arclength(
     elif np.sign(lam_end - lam0) == 0:
         raise ValueError("lam_end must differ from lam0")
     family = OrbitFamily(vector_field, args_of, period_of, k=k, t0=t0, embed=embed, chart=chart, options=opts)
-    stepper = ArclengthStepper.build(
-        family.residual,
-        family.recentre,
-        family.multipliers,
-        newton_tol=opts.newton_tol,
-        newton_max_steps=opts.newton_max_steps,
-    )
-    cold = dataclasses.replace(opts, newton_max_steps=_COLD_NEWTON_STEPS)
-    first = jax.jit(lambda lam, y0: family.solve(lam, y0, cold))
+    first, stepper = _family_programs(family)
 
     orb = first(jnp.asarray(lam0, float), jnp.asarray(y_guess, float))
     if int(orb.status) != 0:

@@ -29,6 +29,8 @@ they are reported as ``trivial_multipliers``.
 from __future__ import annotations
 
 import dataclasses
+import functools
+from collections.abc import Callable
 from typing import Unpack
 
 import diffrax
@@ -317,13 +319,10 @@ def continue_orbit(
         stop = float(st)
     opts = resolve_options(options, BRANCH_DEFAULTS, caller="continue_orbit", **settings)
 
-    def args_of(lam):
-        return eqx.tree_at(lambda p: getattr(p, name), params, jnp.asarray(lam, float))
-
     return continue_arclength(
         CeltField(get_contact_law(contact_law)),
         orbit.y,
-        args_of,
+        _field_setter(params, name),
         _period,
         lam0,
         stop,
@@ -338,6 +337,29 @@ def continue_orbit(
         bisections=bisections,
         callback=callback,
     )
+
+
+def _field_setter(params: CeltParams, name: str) -> Callable:
+    """``lam -> params`` with the field ``name`` set to lam. The same function object comes back for the same stone
+    (equal values of the other fields), so that the branch's compiled programs, keyed on it
+    (`jaxcelt.orbits.branch`), serve the next branch of this stone instead of being compiled again."""
+    others = tuple(
+        (f.name, np.asarray(getattr(params, f.name)).tobytes()) for f in dataclasses.fields(params) if f.name != name
+    )
+    fn, stone = _field_setter_cached(others, name)
+    stone.setdefault("params", params)  # any stone of this key: they differ only in the field fn sets
+    return fn
+
+
+@functools.lru_cache(maxsize=16)
+def _field_setter_cached(key: tuple, name: str) -> tuple[Callable, dict]:
+    """A cache of `_field_setter`'s functions, keyed on the other fields' values (bytes): 16 stones at most."""
+    stone: dict = {}
+
+    def args_of(lam):
+        return eqx.tree_at(lambda p: getattr(p, name), stone["params"], jnp.asarray(lam, float))
+
+    return args_of, stone
 
 
 def locate_orbit_bifurcation(
