@@ -85,14 +85,17 @@ def _row(w: float) -> dict:
     return next(r for r in _d()["summary"]["values"] if abs(r["value"] - w) < 1e-9)
 
 
+def _pair_orbit_mu(w: float) -> float:
+    """The mirror pair's orbit continued by Newton at w rad/s (the largest orbit_multiplier_max of the pair)."""
+    return max(a["orbit_multiplier_max"] for a in _row(w)["attractors"] if a.get("orbit_multiplier_max") is not None)
+
+
 def orbit_sentence() -> str:
-    """The mirror pair's orbit continued by Newton at 17 and 19 rad/s (the largest orbit_multiplier_max of the
-    pair, rounded)."""
-    out = []
-    for w in (17.0, 19.0):
-        mus = [a["orbit_multiplier_max"] for a in _row(w)["attractors"] if a.get("orbit_multiplier_max") is not None]
-        out.append(f"{max(mus):.4f} at {w:g} rad/s")
-    return "largest \\|μ\\| " + " and ".join(out)
+    return f"largest \\|μ\\| {_pair_orbit_mu(17.0):.4f} at 17 rad/s"
+
+
+def orbit_sentence_19() -> str:
+    return f"unstable ({_pair_orbit_mu(19.0):.4f} at 19 rad/s)"
 
 
 def wobblestone_times() -> str:
@@ -124,6 +127,7 @@ QUOTES = [
     (PAGE, duffing_times),
     *[(PAGE, (lambda w=w: read_off_row(w))) for w in READ_OFF],
     (PAGE, orbit_sentence),
+    (PAGE, orbit_sentence_19),
     (PAGE, wobblestone_times),
     (PAGE, _periodic_range),
     (PAGE, _unsettled),
