@@ -33,16 +33,14 @@ import tempfile
 import time
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _compile_log import COMMON_IMPORTS, log_compiles, pre_import  # noqa: E402
+
 PARTS = ("continuation", "brute_force", "branches", "spectrum", "command", "call")
 """the atlas's parts (atlas.json's ``seconds``), its ``command`` total, and ``call``: the call measured here"""
 
 PRE_IMPORTED = (
-    "matplotlib.pyplot",
-    "xarray",
-    "h5py",
-    "h5netcdf",
-    "tqdm.auto",
-    "PIL.Image",
+    *COMMON_IMPORTS,
     "jaxcelt",
     "scipy.linalg",
     "jaxcelt.cli",
@@ -132,12 +130,7 @@ def main(argv=None) -> int:
     if a.reps > 1:
         return _repeated(a)
     os.environ["JAXCELT_CACHE_DIR"] = "off"
-    import importlib
-
-    t = time.perf_counter()
-    for mod in PRE_IMPORTED:  # the modules the command imports on its first run (their time is reported apart)
-        importlib.import_module(mod)
-    imports_s = time.perf_counter() - t
+    imports_s = pre_import(PRE_IMPORTED)  # the modules the command imports on its first run (reported apart)
     import jax
 
     t = time.perf_counter()
@@ -160,12 +153,7 @@ def main(argv=None) -> int:
                     if m:
                         logged.append((stage, m[1], float(m[2])))
 
-    jax.config.update("jax_log_compiles", True)
-    for name in ("jax._src.dispatch", "jax._src.interpreters.pxla", "jax._src.compiler"):
-        lg = logging.getLogger(name)
-        lg.addHandler(Collect())
-        lg.setLevel(logging.DEBUG)
-        lg.propagate = False
+    log_compiles(Collect())
     res: dict = dict(
         smoke=a.smoke,
         argv=atlas_argv(Path("DIR"), a.smoke),

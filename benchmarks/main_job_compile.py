@@ -29,13 +29,11 @@ import tempfile
 import time
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _compile_log import COMMON_IMPORTS, log_compiles, pre_import  # noqa: E402
+
 PRE_IMPORTED = (
-    "matplotlib.pyplot",
-    "xarray",
-    "h5py",
-    "h5netcdf",
-    "tqdm.auto",
-    "PIL.Image",
+    *COMMON_IMPORTS,
     "jaxcelt.cli",
     "jaxcelt.sweeps.dataset",
     "jaxcelt.sweeps.api",
@@ -52,13 +50,8 @@ def main(argv=None) -> int:
     if a.reps > 1:
         return _repeated(a.out, a.reps)
     os.environ["JAXCELT_CACHE_DIR"] = "off"
-    import importlib
-
-    t = time.perf_counter()
     # the modules the command imports on its first run (not counted; their time is reported apart)
-    for mod in PRE_IMPORTED:
-        importlib.import_module(mod)
-    imports_s = time.perf_counter() - t
+    imports_s = pre_import(PRE_IMPORTED)
     import jax
 
     # JAX's CPU backend with the command's device count ("auto"), started before the first run
@@ -79,12 +72,7 @@ def main(argv=None) -> int:
             if m:
                 logged.append((m[1], float(m[2])))
 
-    jax.config.update("jax_log_compiles", True)
-    for name in ("jax._src.dispatch", "jax._src.interpreters.pxla", "jax._src.compiler"):
-        lg = logging.getLogger(name)
-        lg.addHandler(Collect())
-        lg.setLevel(logging.DEBUG)
-        lg.propagate = False
+    log_compiles(Collect())
     # versions() after the runs: it starts JAX's backend, and the command sets the CPU device count first
     res: dict = dict(
         cpu_count=os.cpu_count(),
