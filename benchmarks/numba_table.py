@@ -18,7 +18,8 @@ sweep costs: compilation included, JAX's persistent cache off, numba's on-disk c
   jaxcelt's per-lane step counts (reported per core and as if spread over all cores).
 
 Per mode: the first call (end to end, compilation included) and the median of ``--reps`` warm calls in the
-same process, lane-steps and statuses. Writes one JSON file through `jaxcelt.provenance.write_result` and
+same process, lane-steps and statuses; for jaxcelt also what JAX logs of its tracing, lowering and XLA compilation
+(``jax_log_compiles``, steps of at least 0.05 s) in the first call and in the warm calls. Writes one JSON file through `jaxcelt.provenance.write_result` and
 prints a table with the ratios, versions and CPU.
 
     python benchmarks/numba_table.py --out docs/performance/numba_table_400x300.json
@@ -62,10 +63,25 @@ def child(a) -> dict:
     """One engine and mode in this (fresh) process: the first call, then ``reps`` warm calls."""
     engine, mode = a.child.split(":")
     stop = mode == "stop"
+    log: list[tuple[str, float]] = []
     if engine == "jaxcelt":
+        import logging
+        import re
+
         import jax
 
+        from _compile_log import log_compiles
+
         jax.config.update("jax_num_cpu_devices", os.cpu_count() or 1)
+
+        class Log(logging.Handler):
+            def emit(self, rec):
+                m = re.search(r"Finished (.+?) in ([\d.]+) sec", rec.getMessage())
+                if m and float(m.group(2)) >= 0.05:
+                    log.append((m.group(1), float(m.group(2))))
+
+        sys.path.insert(0, str(HERE))
+        log_compiles(Log())
     nm, jc, p, vals, tr, (PP, B, Bi, TS, Y0) = _setup(a)
     if engine == "jaxcelt":
 
@@ -82,6 +98,7 @@ def child(a) -> dict:
     t = time.perf_counter()
     steps, status = call()
     first = time.perf_counter() - t
+    first_log = list(log)
     warm = []
     for _ in range(a.reps):
         t = time.perf_counter()
@@ -94,7 +111,7 @@ def child(a) -> dict:
         "lane_steps": int(np.sum(steps)),
         "steps_per_lane": [int(x) for x in steps],
         "status_counts": {str(int(k)): int(v) for k, v in zip(*np.unique(status, return_counts=True))},
-    }
+    } | ({"first_call_compile_log": first_log, "warm_calls_compile_log": log[len(first_log):]} if engine == "jaxcelt" else {})
 
 
 def _scipy(a, weights: np.ndarray) -> dict:

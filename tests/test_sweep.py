@@ -261,8 +261,10 @@ def test_pool_other_solvers_equal_simulate(paper_params, solver):
 
 def test_pool_drain_compaction_keeps_lanes(paper_params):
     # 40 lanes through 32 slots: once <= 4 lanes are left the pool continues 4 wide, stepping in
-    # its inner loop (`run_pool`'s drain). Lanes must not depend on the width they ran at: compare
-    # with a pool that is 8 wide from the start. Different widths are different compiled programs
+    # its inner loop (the drain; drain_min_steps=0: whatever the lanes left are predicted to
+    # cost). Lanes must not depend on the width they ran at: compare with a pool that is 8 wide
+    # from the start, and with the same pool finishing at its full width (the default here: the
+    # last lanes' few hundred steps do not pay for compiling the drain). Different widths are different compiled programs
     # (on an AVX-512 CPU ~half the samples differ at <= 1.6e-12 relative), so: same step
     # counts and statuses, samples within SAMPLE_ATOL (see _sweep_common).
     from jaxcelt.ensemble import SweepConfig, run_lanes
@@ -272,12 +274,18 @@ def test_pool_drain_compaction_keeps_lanes(paper_params):
     pb = lanes_params(paper_params, "omega_pi", vals)
     cfg = SweepConfig(transient_periods=0, sample_periods=2, max_steps=4000)
     one = jax.local_devices()[:1]
-    wide = run_lanes(pb, y0, cfg, width=32, devices=one)
+    wide = run_lanes(pb, y0, cfg, width=32, devices=one, drain_min_steps=0)
     narrow = run_lanes(pb, y0, cfg, width=8, devices=one)
     it, paid = int(wide["pool_iterations"][0]), int(wide["pool_slot_steps"][0])
     assert paid < 32 * it  # the drain ran narrower
     assert paid >= int(wide["num_steps"].sum())
     assert_same_lanes(wide, narrow)
+    full = run_lanes(pb, y0, cfg, width=32, devices=one)
+    it, paid = int(full["pool_iterations"][0]), int(full["pool_slot_steps"][0])
+    assert paid == 32 * it  # no drain: every iteration paid 32 slots
+    assert_same_lanes(full, wide)
+    with pytest.raises(ValueError, match="drain_min_steps"):
+        run_lanes(pb, y0, cfg, width=32, devices=one, drain_min_steps=-1)
 
 
 def test_wide_vector_pool_keeps_lanes(paper_params):

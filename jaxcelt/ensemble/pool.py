@@ -13,10 +13,10 @@ Scheduling:
   their predicted remaining cost (steps so far x remaining / elapsed span) and free slots take
   them costliest first (longest-processing-time order), so the drain runs on short lanes. A
   pause does not change a lane: it resumes with the same state and step sequence.
-* The drain: once no more than a quarter of the slots have work left, the running lanes move to
-  a pool a quarter as wide (`DRAIN_FACTOR`), and at the end to one of `MIN_DRAIN_WIDTH` slots
-  (96, 24, 4). Each width compiles the step again, so only pools with a queue (more lanes than
-  slots) do this.
+* The drain: once no more than `MIN_DRAIN_WIDTH` lanes have work left, the running lanes move to
+  a pool of that many slots (96 to 4; `DRAIN_FACTOR`). Each width compiles the step again, so
+  only pools with a queue (more lanes than slots) do this, and `jaxcelt.ensemble.run_lanes` only
+  when the lanes left are predicted to be long (`DRAIN_MIN_STEPS`).
 * A pool of at most `SEQUENTIAL_WIDTH` slots (the drain's last width, or a chunk of a few lanes
   per device) steps in an inner loop until one of its lanes reaches a section time, finishes or
   pauses; that loop touches only small buffers, so XLA's CPU runtime runs its kernels one after the
@@ -52,6 +52,16 @@ __all__ = [
     "DRAIN_FACTOR",
     "SEQUENTIAL_WIDTH",
     "PILOT_FRACTION",
+    "DRAIN_MIN_STEPS",
+    "PoolCarry",
+    "begin_pool",
+    "advance_pool",
+    "narrow_pool",
+    "drain_widths",
+    "pool_work",
+    "remaining_steps",
+    "carry_rows",
+    "carry_from_rows",
 ]
 
 DEFAULT_WIDTH = 96
@@ -61,11 +71,22 @@ the fastest width for 400 lanes x 300 periods on 2 cores with the pilot pause
 (``benchmarks/bench_schedule.py``; docs/internals/sweep-engine.md)."""
 MIN_DRAIN_WIDTH = 4
 """the drain's last width (by default `SEQUENTIAL_WIDTH`, so that it steps in the inner loop)"""
-DRAIN_FACTOR = 4
+DRAIN_FACTOR = 8
 """the drain divides the width by this while the result stays at least this times
-`MIN_DRAIN_WIDTH`, then ends at `MIN_DRAIN_WIDTH`: 96, 24, 4 slots. The last few lanes, which
-run longest when lanes are integrated on, belong in a narrow pool (``benchmarks/bench_drain.py``
--> docs/bifurcation/drain.json)"""
+`MIN_DRAIN_WIDTH`, then ends at `MIN_DRAIN_WIDTH`: 96 slots go straight to 4 (256: 32, then 4).
+The last few lanes, which run longest when lanes are integrated on, belong in a narrow pool
+(``benchmarks/bench_drain.py`` -> docs/bifurcation/drain.json); every intermediate width is
+another compiled step, which costs about as much compilation as the full-width one
+(``benchmarks/numba_table.py`` -> docs/performance/numba_table_400x300.json)"""
+DRAIN_MIN_STEPS = 100_000
+"""`jaxcelt.ensemble.run_lanes` runs the drain's narrower widths, a program of their own, only
+when a lane left at the end of the full-width phase is predicted to need at least this many more
+steps (`remaining_steps`); otherwise the last lanes finish at the full width, and the drain is
+not compiled. Compiling it costs seconds; a full-width iteration costs tens of microseconds more
+than a narrow one, so the drain pays for lanes of ~10^5 steps: lanes that stick to the base when
+lanes are integrated on (``benchmarks/max_steps_study.py``), not the lanes of a sweep that stops
+at invalid states. The decision depends on the lanes alone, so a call gives the same results
+however its programs were compiled or cached."""
 SEQUENTIAL_WIDTH = 4
 """widest pool that steps in the inner loop (`run_pool`). XLA's CPU runtime runs a sequence of
 kernels one after the other on the calling thread when each kernel depends on the one before it,
@@ -154,7 +175,11 @@ class _Slots(NamedTuple):
     ts: Array
 
 
-class _Carry(NamedTuple):
+class PoolCarry(NamedTuple):
+    """The pool between two of its phases (`begin_pool`, `advance_pool`, `narrow_pool`): what a
+    later phase, possibly another compiled program, needs to go on exactly where the last one
+    stopped. Scalars are 0-d (one device's pool)."""
+
     slots: _Slots
     lane: Array  # lane index in each slot (L: empty)
     nxt: Array  # queue position of the next lane not yet started
@@ -164,6 +189,22 @@ class _Carry(NamedTuple):
     samples: Array
     iters: Array
     slot_steps: Array
+    queue: Array  # (L,) the lanes with work at the start, in order
+    n_queue: Array  # how many of them
+
+
+_SCALARS = ("nxt", "iters", "slot_steps", "n_queue")
+
+
+def carry_rows(carry: PoolCarry) -> PoolCarry:
+    """``carry`` with its scalars as (1,) arrays: every leaf has a leading axis, so that the
+    carries of several devices' pools concatenate along it (`jaxcelt.ensemble.shard`)."""
+    return carry._replace(**{k: getattr(carry, k)[None] for k in _SCALARS})
+
+
+def carry_from_rows(carry: PoolCarry) -> PoolCarry:
+    """The inverse of `carry_rows` (inside one device's part)."""
+    return carry._replace(**{k: getattr(carry, k)[0] for k in _SCALARS})
 
 
 def _where_rows(mask: Array, a: Any, b: Any) -> Any:
@@ -172,35 +213,97 @@ def _where_rows(mask: Array, a: Any, b: Any) -> Any:
     )
 
 
-def run_pool(
-    stepper: AbstractLaneStepper,
-    lanes: LaneState,
-    samples: Array,
-    lane_args: tuple[Array, ...],
-    args_of: Callable[[Any], Any],
-    ts_all: Array,
-    t0: Array,
-    *,
-    width: int,
-    pause_frac: Array,
-    min_drain_width: int = MIN_DRAIN_WIDTH,
-    drain_factor: int = DRAIN_FACTOR,
-) -> tuple[LaneState, Array, PoolStats]:
-    """The lanes that are not done yet, in order, through ``width`` slots (refilled as lanes finish).
+def _take(lane: Array, lanes: LaneState, resumed: Array, lane_args: tuple[Array, ...], ts_all: Array) -> _Slots:
+    j = jnp.minimum(lane, resumed.shape[0] - 1)
+    return _Slots(jax.tree_util.tree_map(lambda x: x[j], lanes), resumed[j], tuple(x[j] for x in lane_args), ts_all[j])
 
-    ``lanes``, ``samples``: from `start_lanes` (``samples`` (L, S, n) is written in place);
-    ``lane_args``/``args_of``: `split_lane_args`; ``ts_all`` (L, S): section times. A lane
-    pauses at the end of its first step past t0 + ``pause_frac`` (t1 - t0) (inf: never); it
-    stops between two steps, so resuming it continues the very same step sequence. A pool of at
-    most `SEQUENTIAL_WIDTH` slots whose stepper reads only the next two section times
-    (``stepper.section_window``) steps in an inner loop until a lane reaches a section time,
-    finishes or pauses: the same steps, whose kernels XLA's CPU runtime then runs without its thread
-    pool. Call inside jit. Returns (final lanes, samples, `PoolStats`)."""
+
+def _lane_at(pos: Array, queue: Array, n_queue: Array) -> Array:
+    L = queue.shape[0]
+    return jnp.where(pos < n_queue, queue[jnp.minimum(pos, L - 1)], L).astype(jnp.int32)
+
+
+def pool_work(carry: PoolCarry) -> Array:
+    """Lanes with work left: in a slot, queued, or paused and waiting."""
+    L = carry.wait.shape[0]
+    return jnp.sum(carry.lane < L) + jnp.maximum(carry.n_queue - carry.nxt, 0) + jnp.sum(carry.wait > -jnp.inf)
+
+
+def drain_widths(width: int, n_lanes: int, drain_factor: int = DRAIN_FACTOR, min_drain_width: int = MIN_DRAIN_WIDTH) -> list[int]:
+    """The pool's widths: ``min(width, n_lanes)``, then, only where lanes queue for slots, the
+    drain's: divided by ``drain_factor`` while the result stays at least ``drain_factor`` x
+    ``min_drain_width``, and ``min_drain_width`` last (see `DRAIN_FACTOR`)."""
+    widths = [min(width, n_lanes)]
+    if n_lanes > widths[0]:
+        while widths[-1] // drain_factor >= drain_factor * min_drain_width:
+            widths.append(widths[-1] // drain_factor)
+        if widths[-1] > min_drain_width:
+            widths.append(min_drain_width)
+    return widths
+
+
+def begin_pool(lanes: LaneState, samples: Array, lane_args: tuple[Array, ...], ts_all: Array, *, width: int) -> PoolCarry:
+    """The pool of ``min(width, L)`` slots filled with the first lanes that have work, in order.
+
+    ``lanes``, ``samples``: from `start_lanes`; ``lane_args``: `split_lane_args`; ``ts_all`` (L, S)."""
     L = samples.shape[0]
     B = min(width, L)
     # the queue: lanes with work (not padding, not invalid at t0 with stop_on_invalid), in order
     queue = jnp.argsort(lanes.done, stable=True).astype(jnp.int32)
     n_queue = jnp.sum(~lanes.done).astype(jnp.int32)
+    z = jnp.zeros((), jnp.int32)
+    resumed = jnp.zeros_like(lanes.done)
+    lane = _lane_at(jnp.arange(B, dtype=jnp.int32), queue, n_queue)
+    return PoolCarry(
+        slots=_take(lane, lanes, resumed, lane_args, ts_all),
+        lane=lane,
+        nxt=jnp.minimum(jnp.asarray(B, jnp.int32), n_queue),
+        wait=jnp.full((L,), -jnp.inf),
+        lanes=lanes,
+        resumed=resumed,
+        samples=samples,
+        iters=z,
+        slot_steps=z,
+        queue=queue,
+        n_queue=n_queue,
+    )
+
+
+def narrow_pool(carry: PoolCarry, width: int) -> PoolCarry:
+    """The pool with ``width`` slots: the running lanes first (there must be at most ``width``)."""
+    L = carry.wait.shape[0]
+    keep = jnp.argsort(carry.lane >= L, stable=True)[:width]
+    return carry._replace(slots=jax.tree_util.tree_map(lambda x: x[keep], carry.slots), lane=carry.lane[keep])
+
+
+def remaining_steps(carry: PoolCarry, t0: Any) -> Any:
+    """Each slot's predicted remaining steps: steps so far x remaining / elapsed time span (the
+    pilot pause's estimate; 0 for an empty or finished slot or one that has not stepped yet).
+    Works on a carry of numpy arrays too, and on `carry_rows` carries of several devices (the
+    lane indices are each device's own)."""
+    st = carry.slots.lane
+    L = carry.samples.shape[0] // max(1, carry.nxt.size)  # lanes per device
+    elapsed = st.tprev - t0
+    rate = st.num_steps / (elapsed + (elapsed <= 0))
+    est = (rate * (st.t1 - st.tprev)) * (elapsed > 0)
+    return est * ((carry.lane < L) & ~st.done)
+
+
+def advance_pool(
+    stepper: AbstractLaneStepper,
+    carry: PoolCarry,
+    lane_args: tuple[Array, ...],
+    args_of: Callable[[Any], Any],
+    ts_all: Array,
+    t0: Array,
+    *,
+    pause_frac: Array,
+    until: Array | int = 0,
+) -> PoolCarry:
+    """Step the pool at its width (slots refilled as lanes finish) until no more than ``until``
+    lanes have work left (`pool_work`). Call inside jit; see `run_pool`."""
+    L = carry.samples.shape[0]
+    queue, n_queue = carry.queue, carry.n_queue
 
     def _step(slot: _Slots):
         new, hit = stepper.step(slot.lane, args_of(slot.args), slot.ts)
@@ -208,16 +311,6 @@ def run_pool(
         return slot._replace(lane=new), hit, paused
 
     step_v = jax.vmap(_step)
-
-    def take(lane, lanes, resumed):
-        j = jnp.minimum(lane, L - 1)
-        return _Slots(
-            jax.tree_util.tree_map(lambda x: x[j], lanes), resumed[j], tuple(x[j] for x in lane_args), ts_all[j]
-        )
-
-    def lane_at(pos):
-        return jnp.where(pos < n_queue, queue[jnp.minimum(pos, L - 1)], L).astype(jnp.int32)
-
     no = jnp.asarray(-jnp.inf)
 
     def one_step(slots: _Slots, active: Array):
@@ -257,7 +350,7 @@ def run_pool(
         lane = eqx.tree_at(lambda s: s.k, inner.lane, k0 + inner.lane.k)
         return slots._replace(lane=lane, resumed=inner.resumed, args=inner.args), hit, paused, n
 
-    def body(c: _Carry) -> _Carry:
+    def body(c: PoolCarry) -> PoolCarry:
         slots, lane = c.slots, c.lane
         active = (lane < L) & ~slots.lane.done
         narrow = lane.shape[0] <= SEQUENTIAL_WIDTH and stepper.section_window
@@ -284,12 +377,12 @@ def run_pool(
             from_queue = nxt + rank < n_queue
             by_cost = jnp.argsort(-wait)  # waiting lanes first (the others wait at -inf)
             pick = by_cost[jnp.clip(rank - jnp.maximum(n_queue - nxt, 0), 0, L - 1)]
-            new_lane = jnp.where(from_queue, lane_at(nxt + rank), jnp.where(wait[pick] > no, pick, L))
+            new_lane = jnp.where(from_queue, _lane_at(nxt + rank, queue, n_queue), jnp.where(wait[pick] > no, pick, L))
             new_lane = jnp.where(fin, new_lane, lane).astype(jnp.int32)
             refill = fin & (new_lane < L)
             wait = wait.at[jnp.where(refill & ~from_queue, new_lane, L)].set(no, mode="drop")
             nxt = nxt + jnp.sum(refill & from_queue).astype(jnp.int32)
-            slots = _where_rows(refill, take(new_lane, lanes, resumed), slots)
+            slots = _where_rows(refill, _take(new_lane, lanes, resumed, lane_args, ts_all), slots)
             lane = jnp.where(fin, jnp.where(refill, new_lane, L), lane).astype(jnp.int32)
             return slots, lane, nxt, wait, lanes, resumed
 
@@ -297,40 +390,49 @@ def run_pool(
             jnp.any(fin), swap, lambda a: a, (slots, lane, c.nxt, c.wait, c.lanes, c.resumed)
         )
         iters, paid = c.iters + n_steps, c.slot_steps + n_steps * lane.shape[0]
-        return _Carry(slots, lane, nxt, wait, lanes, resumed, samples, iters, paid)
+        return c._replace(
+            slots=slots, lane=lane, nxt=nxt, wait=wait, lanes=lanes, resumed=resumed, samples=samples,
+            iters=iters, slot_steps=paid,
+        )  # fmt: skip
 
-    # the drain: widths B, B/4, ..., MIN_DRAIN_WIDTH (see the module docstring and DRAIN_FACTOR)
-    widths = [B]
-    if L > B:
-        while widths[-1] // drain_factor >= drain_factor * min_drain_width:
-            widths.append(widths[-1] // drain_factor)
-        if widths[-1] > min_drain_width:
-            widths.append(min_drain_width)
-    z = jnp.zeros((), jnp.int32)
-    resumed = jnp.zeros_like(lanes.done)
-    lane = lane_at(jnp.arange(B, dtype=jnp.int32))
-    carry = _Carry(
-        slots=take(lane, lanes, resumed),
-        lane=lane,
-        nxt=jnp.minimum(jnp.asarray(B, jnp.int32), n_queue),
-        wait=jnp.full((L,), -jnp.inf),
-        lanes=lanes,
-        resumed=resumed,
-        samples=samples,
-        iters=z,
-        slot_steps=z,
-    )
+    def cond(c: PoolCarry) -> Array:
+        return jnp.any(c.lane < L) & (pool_work(c) > until)
+
+    return jax.lax.while_loop(cond, body, carry)
+
+
+def run_pool(
+    stepper: AbstractLaneStepper,
+    lanes: LaneState,
+    samples: Array,
+    lane_args: tuple[Array, ...],
+    args_of: Callable[[Any], Any],
+    ts_all: Array,
+    t0: Array,
+    *,
+    width: int,
+    pause_frac: Array,
+    min_drain_width: int = MIN_DRAIN_WIDTH,
+    drain_factor: int = DRAIN_FACTOR,
+) -> tuple[LaneState, Array, PoolStats]:
+    """The lanes that are not done yet, in order, through ``width`` slots (refilled as lanes finish).
+
+    ``lanes``, ``samples``: from `start_lanes` (``samples`` (L, S, n) is written in place);
+    ``lane_args``/``args_of``: `split_lane_args`; ``ts_all`` (L, S): section times. A lane
+    pauses at the end of its first step past t0 + ``pause_frac`` (t1 - t0) (inf: never); it
+    stops between two steps, so resuming it continues the very same step sequence. A pool of at
+    most `SEQUENTIAL_WIDTH` slots whose stepper reads only the next two section times
+    (``stepper.section_window``) steps in an inner loop until a lane reaches a section time,
+    finishes or pauses: the same steps, whose kernels XLA's CPU runtime then runs without its thread
+    pool. All of the drain's widths (`drain_widths`) in one program; `jaxcelt.ensemble.run_lanes`
+    runs the phases (`begin_pool`, `advance_pool`, `narrow_pool`) as programs of their own. Call
+    inside jit. Returns (final lanes, samples, `PoolStats`)."""
+    L = samples.shape[0]
+    widths = drain_widths(width, L, drain_factor, min_drain_width)
+    carry = begin_pool(lanes, samples, lane_args, ts_all, width=width)
     for nxt_w in [*widths[1:], 0]:
-
-        def cond(c: _Carry, nxt_w=nxt_w):
-            work = jnp.sum(c.lane < L) + jnp.maximum(n_queue - c.nxt, 0) + jnp.sum(c.wait > -jnp.inf)
-            return jnp.any(c.lane < L) & (work > nxt_w)
-
-        carry = jax.lax.while_loop(cond, body, carry)
+        carry = advance_pool(stepper, carry, lane_args, args_of, ts_all, t0, pause_frac=pause_frac, until=nxt_w)
         if nxt_w:
-            keep = jnp.argsort(carry.lane >= L, stable=True)[:nxt_w]  # the running lanes first
-            carry = carry._replace(
-                slots=jax.tree_util.tree_map(lambda x, keep=keep: x[keep], carry.slots), lane=carry.lane[keep]
-            )
-    stats = PoolStats(iterations=carry.iters, slot_steps=carry.slot_steps, width=B)
+            carry = narrow_pool(carry, nxt_w)
+    stats = PoolStats(iterations=carry.iters, slot_steps=carry.slot_steps, width=widths[0])
     return carry.lanes, carry.samples, stats

@@ -30,4 +30,4 @@ class AbstractLaneRunner(abc.ABC):
         """`jaxcelt.ensemble.run_lanes` with ``stats=True`` for the chunk (batched ``pb``, ``y0b``, settings
         ``cfg``): per-lane arrays in lane order and the pool's statistics. ``kwargs``: the pool's
         other settings (``width``, ``compile_only``, ``pilot_fraction``, ``drain_factor``,
-        ``min_drain_width``). ValueError for an ``engine`` the runner cannot use."""
+        ``min_drain_width``, ``drain_min_steps``). ValueError for an ``engine`` the runner cannot use."""

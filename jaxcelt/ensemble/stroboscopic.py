@@ -32,16 +32,25 @@ from jaxcelt.ensemble.kernel import BLOCK, kernel_supported, make_segment, run_k
 from jaxcelt.ensemble.pool import (
     DEFAULT_WIDTH,
     DRAIN_FACTOR,
+    DRAIN_MIN_STEPS,
     MIN_DRAIN_WIDTH,
     PILOT_FRACTION,
+    PoolCarry,
     PoolStats,
+    advance_pool,
+    begin_pool,
+    carry_from_rows,
+    carry_rows,
+    drain_widths,
     lane_outputs,
-    run_pool,
+    narrow_pool,
+    remaining_steps,
     split_lane_args,
     start_lanes,
 )
+from jaxcelt.ensemble.lanes import LaneState
 from jaxcelt.ensemble.runners import AbstractLaneRunner
-from jaxcelt.ensemble.shard import device_mesh, pad_lanes, shard_lanes
+from jaxcelt.ensemble.shard import LANE_AXIS, device_mesh, pad_lanes, shard_lanes
 from jaxcelt.ensemble.stepper import AbstractLaneStepper, FusedERKStepper, erk_tableau, float64_times, make_stepper
 from jaxcelt.integrate.lyapunov import celt_lyapunov
 from jaxcelt.physics.contact.registry import get_contact_law
@@ -108,46 +117,83 @@ def _lyap_lane(p: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig) 
     return lr.exponent, lr.stderr
 
 
-@eqx.filter_jit
-def _pool_chunk(
-    pb: CeltParams,
-    y0b: Array,
-    live: Array,
-    pause_frac: Array,
-    transient: Array,
-    tols: Array,
-    cfg: SweepConfig,
-    width: int,
-    mesh: Any,
-    vary: tuple[bool, ...],
-    opaque_true: Array | None,
-    drain: tuple[int, int] = (DRAIN_FACTOR, MIN_DRAIN_WIDTH),
-) -> tuple[dict[str, Array], Array, Array]:
-    """One chunk of lanes through the pool (per device): per-lane outputs and the loop counters.
+def _pool_times(pb: CeltParams, transient: Array, cfg: SweepConfig, stepper: AbstractLaneStepper) -> Array:
+    """The section times the pool steps onto: float32 lanes of the fused step step in float64 time
+    (`FusedERKStepper`), so theirs come from float64 omega_pi."""
+    if isinstance(stepper, FusedERKStepper) and cfg.dtype != "float64":
+        pb = jax.tree_util.tree_map(lambda x: x.astype(jnp.float64), pb)
+    return _section_times(pb, transient, cfg)
 
-    ``opaque_true``: a traced True (a jit argument: XLA would fold a constant predicate and the
-    fused step's kernel boundaries would vanish), or None: no kernel boundaries. ``vary``: `jaxcelt.ensemble.split_lane_args`.
-    ``drain``: (drain factor, minimum drain width) of `run_pool`."""
+
+@functools.partial(jax.jit, static_argnames=("cfg", "width", "mesh", "vary"))
+def _pool_start(
+    pb: CeltParams, y0b: Array, live: Array, transient: Array, tols: Array, *, cfg: SweepConfig, width: int, mesh: Any,
+    vary: tuple[bool, ...],
+) -> PoolCarry:
+    """The pool's first program (per device): every lane's start (`start_lanes`) and the pool of
+    ``width`` slots filled (`begin_pool`), as a `carry_rows` carry. ``vary``: `split_lane_args`."""
 
     def run(pb, y0b, live):
-        stepper = _stepper(cfg, opaque_true)
+        stepper = _stepper(cfg)
         pv_all, params_of = split_lane_args(pb, vary)
-        ts_all = _section_times(pb, transient, cfg)
         t0 = jnp.asarray(cfg.t0, cfg.dtype)
-        lanes, samples = start_lanes(stepper, pv_all, params_of, y0b, ts_all, live, tols, t0)
+        lanes, samples = start_lanes(stepper, pv_all, params_of, y0b, _section_times(pb, transient, cfg), live, tols, t0)
+        ts_all = _pool_times(pb, transient, cfg, stepper)
         if isinstance(stepper, FusedERKStepper) and cfg.dtype != "float64":
-            # float32 lanes step in float64 time (`FusedERKStepper`): section times from float64 omega_pi
-            ts_all = _section_times(jax.tree_util.tree_map(lambda x: x.astype(jnp.float64), pb), transient, cfg)
             lanes = float64_times(lanes, ts_all[:, -1])
-        lanes, samples, stats = run_pool(
-            stepper, lanes, samples, pv_all, params_of, ts_all, t0, width=width, pause_frac=pause_frac,
-            drain_factor=drain[0], min_drain_width=drain[1],
-        )  # fmt: skip
-        out = dict(lane_outputs(stepper, lanes).as_dict(), samples=samples, t_samples=ts_all)
-        out.update(jax.vmap(_extras)(samples, pb))
-        return out, stats.iterations[None], stats.slot_steps[None]  # loop counters: one per device
+        return carry_rows(begin_pool(lanes, samples, pv_all, ts_all, width=width))
 
     return shard_lanes(run, mesh, 3)(pb, y0b, live)
+
+
+@functools.partial(jax.jit, static_argnames=("cfg", "mesh", "vary", "narrow_to"))
+def _pool_advance(
+    pb: CeltParams, carry: PoolCarry, pause_frac: Array, transient: Array, until: Array, opaque_true: Array | None,
+    *, cfg: SweepConfig, mesh: Any, vary: tuple[bool, ...], narrow_to: tuple[int, ...],
+) -> PoolCarry:
+    """The pool stepped on (per device, `advance_pool`): at its width until no more than ``until``
+    lanes have work left (``narrow_to`` empty), or through the drain's narrower widths
+    ``narrow_to`` to the end. ``opaque_true``: a traced True (a jit argument: XLA would fold a
+    constant predicate and the fused step's kernel boundaries would vanish), or None: no kernel
+    boundaries."""
+
+    def run(pb, carry):
+        stepper = _stepper(cfg, opaque_true)
+        pv_all, params_of = split_lane_args(pb, vary)
+        ts_all = _pool_times(pb, transient, cfg, stepper)
+        t0 = jnp.asarray(cfg.t0, cfg.dtype)
+        c = carry_from_rows(carry)
+        step = functools.partial(advance_pool, stepper, lane_args=pv_all, args_of=params_of, ts_all=ts_all, t0=t0,
+                                 pause_frac=pause_frac)  # fmt: skip
+        if not narrow_to:
+            c = step(c, until=until)
+        for w, nxt in zip(narrow_to, [*narrow_to[1:], 0]):
+            c = step(narrow_pool(c, w), until=nxt)
+        return carry_rows(c)
+
+    return shard_lanes(run, mesh, 2)(pb, carry)
+
+
+@functools.partial(jax.jit, static_argnames=("cfg", "mesh"))
+def _pool_outputs(
+    pb: CeltParams, lanes: LaneState, samples: Array, transient: Array, *, cfg: SweepConfig, mesh: Any
+) -> dict[str, Array]:
+    """The per-lane outputs from the pool's final lane table and samples (per device)."""
+
+    def run(pb, lanes, samples):
+        stepper = _stepper(cfg)
+        out = dict(lane_outputs(stepper, lanes).as_dict(), samples=samples, t_samples=_pool_times(pb, transient, cfg, stepper))
+        out.update(jax.vmap(_extras)(samples, pb))
+        return out
+
+    return shard_lanes(run, mesh, 3)(pb, lanes, samples)
+
+
+def _abstract(tree: Any, mesh: Any) -> Any:
+    """``tree``'s shapes (e.g. a lowered program's ``out_info``) with the lane-axis sharding of ``mesh``: a program taking
+    it is compiled for the arrays the pool's programs hand on."""
+    spec = None if mesh is None else jax.sharding.NamedSharding(mesh, jax.sharding.PartitionSpec(LANE_AXIS))
+    return jax.tree_util.tree_map(lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=spec), tree)
 
 
 @eqx.filter_jit
@@ -228,6 +274,7 @@ def run_lanes(
     pilot_fraction: float = PILOT_FRACTION,
     drain_factor: int = DRAIN_FACTOR,
     min_drain_width: int = MIN_DRAIN_WIDTH,
+    drain_min_steps: int = DRAIN_MIN_STEPS,
     engine: str = "auto",
     stats: bool = False,
 ) -> dict[str, np.ndarray] | tuple[dict[str, np.ndarray], PoolStats]:
@@ -239,7 +286,9 @@ def run_lanes(
     ``pilot_fraction`` (default `PILOT_FRACTION`; 0 = off; only used when a device has more
     lanes than slots): each lane pauses once after this fraction of its time span and is taken
     up again costliest-predicted first. ``drain_factor``, ``min_drain_width``: the pool's drain
-    schedule (`jaxcelt.ensemble.pool`). The Lyapunov stage (``cfg.lyapunov_periods > 0``) then
+    schedule (`jaxcelt.ensemble.pool`); ``drain_min_steps`` (default `DRAIN_MIN_STEPS`): the drain's
+    narrower widths, a program of their own, run only when a lane left at the end of the
+    full-width phase is predicted to need at least this many more steps (0: always). The Lyapunov stage (``cfg.lyapunov_periods > 0``) then
     runs vmapped over the successful lanes in groups of the pool's width ordered by the measured
     main-solve step count (a cost estimate that needs no pilot run).
 
@@ -264,7 +313,8 @@ def run_lanes(
     """
     out, st = _run_lanes(
         pb, y0b, cfg, devices=devices, pad_to=pad_to, width=width, compile_only=compile_only, varying=varying,
-        pilot_fraction=pilot_fraction, drain_factor=drain_factor, min_drain_width=min_drain_width, engine=engine,
+        pilot_fraction=pilot_fraction, drain_factor=drain_factor, min_drain_width=min_drain_width,
+        drain_min_steps=drain_min_steps, engine=engine,
     )  # fmt: skip
     if stats:
         return out, st
@@ -298,13 +348,14 @@ def _run_lanes(
     pilot_fraction: float,
     drain_factor: int,
     min_drain_width: int,
+    drain_min_steps: int,
     engine: str,
 ) -> tuple[dict[str, np.ndarray], PoolStats]:
     """`run_lanes` with the statistics apart (its body)."""
     check_engine(engine, cfg.solver)
     if isinstance(devices, AbstractLaneRunner):  # the whole chunk runs elsewhere (e.g. worker processes)
         kw = dict(width=width, compile_only=compile_only, pilot_fraction=pilot_fraction)
-        kw.update(drain_factor=drain_factor, min_drain_width=min_drain_width)
+        kw.update(drain_factor=drain_factor, min_drain_width=min_drain_width, drain_min_steps=drain_min_steps)
         return devices.run(pb, y0b, cfg, pad_to=pad_to, varying=tuple(varying), engine=engine, **kw)
     mesh = device_mesh(devices)
     L = int(np.shape(y0b)[0])
@@ -327,7 +378,7 @@ def _run_lanes(
     W = int(width or DEFAULT_WIDTH)
     if W < 1:
         raise ValueError(f"width must be >= 1, got {width!r}")
-    for name, v, lo in (("drain_factor", drain_factor, 2), ("min_drain_width", min_drain_width, 1)):
+    for name, v, lo in (("drain_factor", drain_factor, 2), ("min_drain_width", min_drain_width, 1), ("drain_min_steps", drain_min_steps, 0)):
         if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < lo:
             raise ValueError(f"{name} must be an int >= {lo}, got {v!r}")
     nocfg = dataclasses.replace(static_cfg, lyapunov_periods=0)
@@ -366,11 +417,45 @@ def _run_lanes(
             pool_lowered = _kernel_chunk.lower(*pool_args)
         pool_compiled = compile_later(pool_lowered.compile)
     else:
-        pool_args = (pb_p, y0_np[pos_lane].astype(dt), live, jnp.asarray(frac), transient, tols, nocfg, Wd, mesh, vary,
-                     opaque_true, (int(drain_factor), int(min_drain_width)))  # fmt: skip
+        # the pool in three programs (`_pool_start`, `_pool_advance`, `_pool_outputs`), compiled
+        # at the same time on worker threads; the drain's narrower widths are a fourth program,
+        # compiled only when the lanes left are predicted to need it (`DRAIN_MIN_STEPS`)
+        widths = drain_widths(Wd, Lloc, int(drain_factor), int(min_drain_width))
+        y0_p = y0_np[pos_lane].astype(dt)
+        start_kw = dict(cfg=nocfg, width=Wd, mesh=mesh, vary=vary)
+        adv_kw = dict(cfg=nocfg, mesh=mesh, vary=vary)
+        pause, no_until = jnp.asarray(frac), jnp.asarray(0, jnp.int32)
         with gc_paused():
-            pool_lowered = _pool_chunk.lower(*pool_args)
-        pool_compiled = compile_later(functools.partial(pool_lowered.compile, pool_compiler_options(platform, Wd)))
+            start_lowered = _pool_start.lower(pb_p, y0_p, live, transient, tols, **start_kw)
+            carry_spec = _abstract(start_lowered.out_info, mesh)
+            wide_lowered = _pool_advance.lower(pb_p, carry_spec, pause, transient, no_until, opaque_true, narrow_to=(), **adv_kw)
+        wide_compiled = compile_later(functools.partial(wide_lowered.compile, pool_compiler_options(platform, Wd)))
+        start_compiled = compile_later(start_lowered.compile)
+        with gc_paused():
+            out_lowered = _pool_outputs.lower(pb_p, carry_spec.lanes, carry_spec.samples, transient, cfg=nocfg, mesh=mesh)
+        out_compiled = compile_later(out_lowered.compile)
+
+        def drain_program():
+            with gc_paused():
+                lowered = _pool_advance.lower(pb_p, carry_spec, pause, transient, no_until, opaque_true,
+                                              narrow_to=tuple(widths[1:]), **adv_kw)  # fmt: skip
+            return lowered.compile(pool_compiler_options(platform, widths[-1]))
+
+        drain_compiled = compile_later(drain_program) if compile_only and len(widths) > 1 else None
+        carry = start_compiled.result()(pb_p, y0_p, live, transient, tols)
+        wide = wide_compiled.result()
+        carry = wide(pb_p, carry, pause, transient, jnp.asarray(widths[1] if len(widths) > 1 else 0, jnp.int32), opaque_true)
+        if len(widths) > 1 and np.any(np.asarray(carry.lane) < Lloc):
+            # the lanes left: through the narrow drain if their predicted remaining steps pay for
+            # its compilation, else on at the full width (the same lanes either way)
+            left = remaining_steps(jax.tree_util.tree_map(np.asarray, carry), float(nocfg.t0))
+            if compile_only or float(np.max(left)) >= drain_min_steps:
+                if drain_compiled is None:
+                    drain_compiled = compile_later(drain_program)
+                carry = drain_compiled.result()(pb_p, carry, pause, transient, no_until, opaque_true)
+            else:
+                carry = wide(pb_p, carry, pause, transient, no_until, opaque_true)
+        pool_result = out_compiled.result()(pb_p, carry.lanes, carry.samples, transient), carry.iters, carry.slot_steps
     lyap_compiled = None
     if cfg.lyapunov_periods > 0 and not compile_only:
         example = (jax.tree_util.tree_map(lambda x: x[:1].repeat(G, 0), pb_np), np.zeros((G, 13)), np.zeros(G))
@@ -382,7 +467,7 @@ def _run_lanes(
         lane_iters = np.asarray(lane_iters)  # each lane: its block's loop iterations
         stats = PoolStats(iterations=int(lane_iters.max()), slot_steps=int(lane_iters.sum()), width=BLOCK)
     else:
-        out, iters, slot_steps = pool_compiled.result()(*pool_args)
+        out, iters, slot_steps = pool_result
         stats = PoolStats(iterations=int(np.asarray(iters).max()), slot_steps=int(np.sum(np.asarray(slot_steps))), width=Wd)
     out = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(out))
     inv = np.empty_like(pos_lane)
