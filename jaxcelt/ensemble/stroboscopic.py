@@ -404,8 +404,8 @@ def _run_lanes(
         nocfg = dataclasses.replace(nocfg, contact_law=get_contact_law(nocfg.contact_law).wide_batch())
     G = Wd * ndev  # the Lyapunov stage's chunk: the pool's width (a chunk of few lanes solves no padding copies)
     lyap_fn = _lyap_chunk["cpu" if platform == "cpu" else "other"]
-    # The pool's program and the Lyapunov stage's are traced here, one after the other, and
-    # compiled by XLA on worker threads at the same time (XLA releases the GIL while compiling); both
+    # The pool's programs and the Lyapunov stage's are traced here, one after the other, and
+    # compiled by XLA on worker threads at the same time (XLA releases the GIL while compiling); all
     # are then called as compiled programs. Later chunks of the same shapes find them in JAX's caches.
     if use_kernel:
         leaves, treedef = jax.tree_util.tree_flatten(pb_p)
@@ -441,21 +441,25 @@ def _run_lanes(
                                               narrow_to=tuple(widths[1:]), **adv_kw)  # fmt: skip
             return lowered.compile(pool_compiler_options(platform, widths[-1]))
 
-        drain_compiled = compile_later(drain_program) if compile_only and len(widths) > 1 else None
-        carry = start_compiled.result()(pb_p, y0_p, live, transient, tols)
-        wide = wide_compiled.result()
-        carry = wide(pb_p, carry, pause, transient, jnp.asarray(widths[1] if len(widths) > 1 else 0, jnp.int32), opaque_true)
-        if len(widths) > 1 and np.any(np.asarray(carry.lane) < Lloc):
-            # the lanes left: through the narrow drain if their predicted remaining steps pay for
-            # its compilation, else on at the full width (the same lanes either way)
-            left = remaining_steps(jax.tree_util.tree_map(np.asarray, carry), float(nocfg.t0))
-            if compile_only or float(np.max(left)) >= drain_min_steps:
-                if drain_compiled is None:
-                    drain_compiled = compile_later(drain_program)
-                carry = drain_compiled.result()(pb_p, carry, pause, transient, no_until, opaque_true)
-            else:
-                carry = wide(pb_p, carry, pause, transient, no_until, opaque_true)
-        pool_result = out_compiled.result()(pb_p, carry.lanes, carry.samples, transient), carry.iters, carry.slot_steps
+        def run_pool_programs():
+            drain_compiled = compile_later(drain_program) if compile_only and len(widths) > 1 else None
+            carry = start_compiled.result()(pb_p, y0_p, live, transient, tols)
+            wide = wide_compiled.result()
+            until = jnp.asarray(widths[1] if len(widths) > 1 else 0, jnp.int32)
+            carry = wide(pb_p, carry, pause, transient, until, opaque_true)
+            if len(widths) > 1 and np.any(np.asarray(carry.lane) < Lloc):
+                # the lanes left: through the narrow drain if they are predicted to need at least
+                # drain_min_steps more steps, else on at the full width (the same lanes either way)
+                left = remaining_steps(jax.tree_util.tree_map(np.asarray, carry), float(nocfg.t0))
+                if compile_only or float(np.max(left)) >= drain_min_steps:
+                    if drain_compiled is None:
+                        drain_compiled = compile_later(drain_program)
+                    carry = drain_compiled.result()(pb_p, carry, pause, transient, no_until, opaque_true)
+                else:
+                    carry = wide(pb_p, carry, pause, transient, no_until, opaque_true)
+            out = out_compiled.result()(pb_p, carry.lanes, carry.samples, transient)
+            return out, carry.iters, carry.slot_steps
+
     lyap_compiled = None
     if cfg.lyapunov_periods > 0 and not compile_only:
         example = (jax.tree_util.tree_map(lambda x: x[:1].repeat(G, 0), pb_np), np.zeros((G, 13)), np.zeros(G))
@@ -467,7 +471,7 @@ def _run_lanes(
         lane_iters = np.asarray(lane_iters)  # each lane: its block's loop iterations
         stats = PoolStats(iterations=int(lane_iters.max()), slot_steps=int(lane_iters.sum()), width=BLOCK)
     else:
-        out, iters, slot_steps = pool_result
+        out, iters, slot_steps = run_pool_programs()
         stats = PoolStats(iterations=int(np.asarray(iters).max()), slot_steps=int(np.sum(np.asarray(slot_steps))), width=Wd)
     out = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(out))
     inv = np.empty_like(pos_lane)
