@@ -9,7 +9,8 @@
 2. The whole sweep, stopping at invalid states and integrating on, with the drain dividing the
    width by 4 down to 6 slots (96, 24, 6: every width steps once per iteration) and down to 4 slots
    (96, 24, 4: the library's default; the last width steps in the inner loop): compile apart, run
-   time, iterations, step slots paid.
+   time, iterations, step slots paid. Both schedules run their drain whatever the lanes left are predicted to
+   cost (``drain_min_steps=0``).
 
     .venv/bin/python benchmarks/bench_drain.py --out docs/bifurcation
 """
@@ -68,7 +69,7 @@ def main():
         res["schedules"][name] = dict(min_drain_width=md, drain_factor=fac)
         for stop in (True, False):
             cfg = SweepConfig(transient_periods=200, sample_periods=100, stop_on_invalid=stop)
-            out, r = run(vals, cfg, reps=3 if stop else 1, min_drain_width=md, drain_factor=fac)
+            out, r = run(vals, cfg, reps=3 if stop else 1, min_drain_width=md, drain_factor=fac, drain_min_steps=0)
             assert r["compile_s"] > 1.0, "a compiled program of another schedule was reused"
             res["schedules"][name]["stop_on_invalid" if stop else "integrate_on"] = r
             print(name, "stop" if stop else "on", r, flush=True)

@@ -86,7 +86,9 @@ def test_pool_stats_follow_the_schedule(fused):
     assert int(stats.slot_steps) >= int(lanes["num_steps"].sum())
 
 
-@pytest.mark.parametrize(("name", "value"), [("drain_factor", 1), ("drain_factor", 2.5), ("min_drain_width", 0)])
+@pytest.mark.parametrize(
+    ("name", "value"), [("drain_factor", 1), ("drain_factor", 2.5), ("min_drain_width", 0), ("drain_min_steps", -1)]
+)
 def test_drain_options_are_checked(paper_params, name, value):
     # checked before anything is traced: a clear error naming the option
     from jaxcelt.ensemble.stroboscopic import SweepConfig, run_lanes
@@ -95,3 +97,34 @@ def test_drain_options_are_checked(paper_params, name, value):
     y0 = np.tile(np.asarray(jc.initial_state(paper_params)), (2, 1))
     with pytest.raises(ValueError, match=name):
         run_lanes(pb, y0, SweepConfig(transient_periods=1, sample_periods=1), stats=True, **{name: value})
+
+
+def test_drain_widths_schedule():
+    # the documented schedule (`DRAIN_FACTOR`): no queue, no drain; 96 slots go straight to 4;
+    # a wider pool passes through factor-of-8 widths while they stay >= 8 x 4
+    from jaxcelt.ensemble.pool import drain_widths
+
+    assert drain_widths(96, 50) == [50]
+    assert drain_widths(96, 200) == [96, 4]
+    assert drain_widths(256, 1000) == [256, 32, 4]
+    assert drain_widths(96, 200, drain_factor=4) == [96, 24, 4]
+    assert drain_widths(4, 200) == [4]
+
+
+def test_remaining_steps_prediction():
+    # steps so far x remaining span / elapsed span, for running lanes only; numpy in, numpy out.
+    # Slots: a lane 1/4 through its span after 100 steps (300 more), one not stepped yet (0),
+    # a finished one (0), an empty slot (0).
+    from types import SimpleNamespace
+
+    from jaxcelt.ensemble.pool import remaining_steps
+
+    lane = SimpleNamespace(
+        tprev=np.array([2.5, 0.0, 10.0, 3.0]), t1=np.full(4, 10.0), num_steps=np.array([100, 0, 80, 7]),
+        done=np.array([False, False, True, False]),
+    )  # fmt: skip
+    L = 6  # lanes per device: lane index 6 marks an empty slot
+    carry = SimpleNamespace(
+        slots=SimpleNamespace(lane=lane), lane=np.array([0, 1, 2, L]), samples=np.zeros((L, 3, 13)), nxt=np.array(0)
+    )
+    np.testing.assert_allclose(remaining_steps(carry, 0.0), [300.0, 0.0, 0.0, 0.0], rtol=1e-15)

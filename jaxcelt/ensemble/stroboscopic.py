@@ -3,8 +3,9 @@
 For a lane with forcing frequency omega_pi the section times are t0 + (transient + k) 2 pi /
 omega_pi, k = 0 .. S-1 (`SweepConfig`); the stepper steps exactly onto them, so the samples are
 solver states. `run_lanes` runs one chunk of lanes: padded and dealt round-robin over the
-devices (`jaxcelt.ensemble.shard`), through the pool (`jaxcelt.ensemble.pool`) in one jitted
-call per device, then the optional Lyapunov stage; or hands the chunk to an
+devices (`jaxcelt.ensemble.shard`), through the pool (`jaxcelt.ensemble.pool`: a start program,
+the full-width phase, the drain's narrow width when the lanes left are long, the outputs; each one
+jitted call over the devices), then the optional Lyapunov stage; or hands the chunk to an
 `jaxcelt.ensemble.runners.AbstractLaneRunner` (worker processes). Chunking, resumable writing and
 several processes of a distributed run are `jaxcelt.sweeps.driver`'s business.
 """
