@@ -345,7 +345,7 @@ QUOTES = [
     ("docs/internals/sweep-engine.md", lambda: "steps ({:.1f} M against {:.1f} M)".format(
         _vector_width()["on"]["512"]["steps"] / 1e6, _vector_width()["on"]["256"]["steps"] / 1e6)),
     ("docs/internals/sweep-engine.md", lambda: "critical path is the {} lanes that hit max_steps".format(_bench()["jaxcelt_pool"]["status_counts"]["1"])),
-    ("docs/internals/sweep-engine.md", lambda: "the 400 × 300 sweep's pool compiles in {:.1f} s".format(_bench()["summary"]["compile_s"])),
+    ("docs/internals/sweep-engine.md", lambda: "the 400 × 300 sweep's pool compiled in {:.1f} s".format(_bench()["summary"]["compile_s"])),
     ("docs/internals/sweep-engine.md", lambda: "load average {:.1f} at the start, {:.1f} over 5 minutes".format(
         *_json("docs/bifurcation/step_parts.json")["load_average_at_start"][:2])),
     ("docs/internals/sweep-engine.md", lambda: "1-minute load average {:.1f} at the start), 96 lanes".format(

@@ -1,0 +1,85 @@
+"""Quoted texts of the section "The main job at scale against numba, compilation included" of the sweep engine's
+internals page (benchmarks/numba_table.py -> docs/performance/numba_table_400x300.json, the engine as it is, and
+docs/performance/numba_table_400x300_one_program.json, commit 8d5565a: the pool as one program), each computed
+from those files.
+
+Each entry is (document, function returning the quoted text).
+"""
+
+from __future__ import annotations
+
+from .files import _json
+
+PAGE = "docs/internals/sweep-engine.md"
+AFTER = "docs/performance/numba_table_400x300.json"
+BEFORE = "docs/performance/numba_table_400x300_one_program.json"
+MODES = (("stop", "stop at invalid"), ("on", "integrate on"))
+
+
+def _statuses(c: dict) -> str:
+    return ", ".join(f"{v} × {k}" for k, v in sorted(c.items()))
+
+
+def row(path: str, label: str, mode: str, name: str) -> str:
+    m = _json(path)["modes"][mode]
+    j, n = m["jaxcelt"], m["numba"]
+    return (
+        f"| {label} | {name} | {j['warm_s']:.1f} | {n['warm_s']:.1f} | {m['warm_speedup_vs_numba']:.2f}× | "
+        f"{j['first_call_s']:.1f} | {n['first_call_s']:.1f} | {m['first_call_speedup_vs_numba']:.2f}× | "
+        f"{m['first_call_minus_warm_jaxcelt_s']:.1f} | {j['lane_steps'] / 1e6:.1f} M / {n['lane_steps'] / 1e6:.1f} M |"
+    )
+
+
+def xla(path: str, mode: str) -> str:
+    """The first call's XLA compilation per pool program, in the order JAX logged them."""
+    log = _json(path)["modes"][mode]["jaxcelt"]["first_call_compile_log"]
+    parts = [(n.split("jit(")[1].rstrip(")"), t) for n, t in log if n.startswith("XLA compilation") and "_pool" in n]
+    return ", ".join(f"`{n}` {t:.1f} s" for n, t in parts)
+
+
+def statuses(mode: str) -> str:
+    m = _json(AFTER)["modes"][mode]
+    return f"jaxcelt {_statuses(m['jaxcelt']['status_counts'])}; numba {_statuses(m['numba']['status_counts'])}"
+
+
+def load() -> str:
+    a, b = (_json(p)["provenance"]["load_average_at_start"][0] for p in (BEFORE, AFTER))
+    return f"1-minute load average {a:.1f} and {b:.1f} at the starts"
+
+
+def scipy() -> str:
+    s = _json(AFTER)["scipy_stop"]
+    return f"{s['one_core_s']:.0f} s on one core ({s['all_cores_s']:.0f} s spread over {s['cores']} cores"
+
+
+def prose() -> list[str]:
+    """The section's sentences that repeat the table's numbers."""
+    b, a = (_json(p)["modes"] for p in (BEFORE, AFTER))
+    return [
+        f"a first call costs {a['stop']['first_call_minus_warm_jaxcelt_s']:.1f} s more than a warm one stopping at invalid "
+        f"states ({b['stop']['first_call_minus_warm_jaxcelt_s']:.1f} s before)",
+        f"({a['stop']['jaxcelt']['warm_s']:.1f} s against {b['stop']['jaxcelt']['warm_s']:.1f} s)",
+        f"(numba's own first call: {b['stop']['numba']['first_call_s']:.1f} s and {a['stop']['numba']['first_call_s']:.1f} s",
+    ]
+
+
+def first_calls() -> str:
+    m = _json(AFTER)["modes"]
+    return (
+        f"{m['stop']['jaxcelt']['first_call_s']:.1f} s against {m['stop']['numba']['first_call_s']:.1f} s stopping at "
+        f"invalid states, {m['on']['jaxcelt']['first_call_s']:.1f} s against {m['on']['numba']['first_call_s']:.1f} s "
+        f"integrating every lane on"
+    )
+
+
+QUOTES = [
+    ("docs/performance.md", first_calls),
+    *[(PAGE, (lambda i=i: prose()[i])) for i in range(3)],
+    *[(PAGE, (lambda p=p, lab=lab, m=m, n=n: row(p, lab, m, n)))
+      for p, lab in ((BEFORE, "one program (8d5565a)"), (AFTER, "separate programs"))
+      for m, n in MODES],  # fmt: skip
+    *[(PAGE, (lambda p=p, m=m: xla(p, m))) for p in (BEFORE, AFTER) for m in ("stop", "on")],
+    *[(PAGE, (lambda m=m: statuses(m))) for m in ("stop", "on")],
+    (PAGE, load),
+    (PAGE, scipy),
+]
