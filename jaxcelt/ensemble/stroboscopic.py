@@ -452,13 +452,15 @@ def _run_lanes(
                 # the lanes left: through the narrow drain if they are predicted to need at least
                 # drain_min_steps more steps, else on at the full width (the same lanes either way)
                 left = remaining_steps(jax.tree_util.tree_map(np.asarray, carry), float(nocfg.t0))
-                if compile_only or float(np.max(left)) >= drain_min_steps:
+                if float(np.max(left)) >= drain_min_steps:
                     if drain_compiled is None:
                         drain_compiled = compile_later(drain_program)
                     carry = drain_compiled.result()(pb_p, carry, pause, transient, no_until, opaque_true)
                 else:
                     carry = wide(pb_p, carry, pause, transient, no_until, opaque_true)
             out = out_compiled.result()(pb_p, carry.lanes, carry.samples, transient)
+            if drain_compiled is not None:  # compile_only: every program compiled before returning
+                drain_compiled.result()
             return out, carry.iters, carry.slot_steps
 
     lyap_compiled = None
