@@ -451,8 +451,8 @@ def _run_lanes(
             if len(widths) > 1 and np.any(np.asarray(carry.lane) < Lloc):
                 # the lanes left: through the narrow drain if they are predicted to need at least
                 # drain_min_steps more steps, else on at the full width (the same lanes either way)
-                left = remaining_steps(jax.tree_util.tree_map(np.asarray, carry), float(nocfg.t0))
-                if float(np.max(left)) >= drain_min_steps:
+                left = float(jnp.max(remaining_steps(carry, float(nocfg.t0))))  # on the device: the slots only
+                if left >= drain_min_steps:
                     if drain_compiled is None:
                         drain_compiled = compile_later(drain_program)
                     carry = drain_compiled.result()(pb_p, carry, pause, transient, no_until, opaque_true)
