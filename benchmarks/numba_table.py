@@ -69,7 +69,6 @@ def child(a) -> dict:
         import re
 
         import jax
-
         from _compile_log import log_compiles
 
         jax.config.update("jax_num_cpu_devices", os.cpu_count() or 1)

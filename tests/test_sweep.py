@@ -236,10 +236,10 @@ def test_pool_other_solvers_equal_simulate(paper_params, solver):
     # on the samples and 3 % on the step count -- what "same method, same tolerance" means.
     import diffrax
 
-    from jaxcelt.ensemble.stroboscopic import SweepConfig, _erk_tableau
+    from jaxcelt.ensemble import erk_tableau
 
     s = getattr(diffrax, solver)()
-    fused = _erk_tableau(SweepConfig(solver=s)) is not None
+    fused = erk_tableau(s) is not None
     assert fused == (solver == "Dopri8")
     vals = VALUES[1:3]
     tol = 1e-7 if fused else 1e-5  # Heun is 2nd order

@@ -16,6 +16,8 @@
 * `stroboscopic`: `run_lanes`, one chunk of lanes sampled at the forcing's section times,
   sharded over devices, through the pool or the kernel (`ENGINES`), with the optional Lyapunov
   stage.
+* `lane_programs`: the jitted programs `run_lanes` runs a chunk through: the pool's (start,
+  full-width phase, drain, outputs; `prepare_pool`) and what they share with the kernel's.
 
 The user-facing sweeps (`jaxcelt.sweeps`: `bifurcation`, `parameter_map`, ...) are built on it; the engine
 imports nothing of them (nor of `jaxcelt.orbits` or `jaxcelt.identify`).

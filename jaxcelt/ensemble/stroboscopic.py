@@ -13,7 +13,6 @@ several processes of a distributed run are `jaxcelt.sweeps.driver`'s business.
 from __future__ import annotations
 
 import dataclasses
-import functools
 import math
 import warnings
 from collections.abc import Sequence
@@ -25,37 +24,26 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxcelt import _config  # noqa: F401
-from jaxcelt._compile_options import compiler_options, is_wide_pool, pool_compiler_options
+from jaxcelt._compile_options import compiler_options, is_wide_pool
 from jaxcelt._executable_cache import compile_later, gc_paused, start_deferred
 from jaxcelt._types import Array
 from jaxcelt.ensemble.config import ENGINES, SweepConfig, check_engine
 from jaxcelt.ensemble.kernel import BLOCK, kernel_supported, make_segment, run_kernel_lanes
+from jaxcelt.ensemble.lane_programs import lane_extras, lane_stepper, prepare_pool, section_times
 from jaxcelt.ensemble.pool import (
     DEFAULT_WIDTH,
     DRAIN_FACTOR,
     DRAIN_MIN_STEPS,
     MIN_DRAIN_WIDTH,
     PILOT_FRACTION,
-    PoolCarry,
     PoolStats,
-    advance_pool,
-    begin_pool,
-    carry_from_rows,
-    carry_rows,
-    drain_widths,
-    lane_outputs,
-    narrow_pool,
-    remaining_steps,
-    split_lane_args,
     start_lanes,
 )
-from jaxcelt.ensemble.lanes import LaneState
 from jaxcelt.ensemble.runners import AbstractLaneRunner
-from jaxcelt.ensemble.shard import LANE_AXIS, device_mesh, pad_lanes, shard_lanes
-from jaxcelt.ensemble.stepper import AbstractLaneStepper, FusedERKStepper, erk_tableau, float64_times, make_stepper
+from jaxcelt.ensemble.shard import device_mesh, pad_lanes, shard_lanes
+from jaxcelt.ensemble.stepper import float64_times
 from jaxcelt.integrate.lyapunov import celt_lyapunov
 from jaxcelt.physics.contact.registry import get_contact_law
-from jaxcelt.physics.diagnostics import centre_position
 from jaxcelt.physics.params import PARAM_NAMES, CeltParams
 
 __all__ = ["SweepConfig", "lanes_params", "run_lanes", "run_lanes_with_stats", "ENGINES", "check_engine"]
@@ -68,38 +56,6 @@ def lanes_params(params: CeltParams, name: str, values: Array) -> CeltParams:
     L = values.shape[0]
     pb = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(jnp.asarray(x), (L,)), params)
     return eqx.tree_at(lambda p: getattr(p, name), pb, values)
-
-
-def _extras(ys: Array, p: CeltParams) -> dict[str, Array]:
-    """Global motion of O from one lane's samples (S, 13); samples after a stop (inf) ignored."""
-    r_O = jax.vmap(centre_position, in_axes=(0, None))(ys, p)
-    dist = jnp.linalg.norm(r_O[:, :2] - r_O[0:1, :2], axis=-1)
-    fin = jnp.isfinite(dist)
-    last = jnp.max(jnp.where(fin, jnp.arange(dist.shape[0]), -1))
-    drift = jnp.where(last >= 0, dist[jnp.maximum(last, 0)], jnp.nan)
-    exc = jnp.where(last >= 0, jnp.max(jnp.where(fin, dist, -jnp.inf)), jnp.nan)
-    return dict(drift=drift, max_excursion=exc, r_O=r_O)
-
-
-def _erk_tableau(cfg: SweepConfig) -> Any:
-    """`jaxcelt.ensemble.erk_tableau` of the sweep's solver: the fused step's tableau, or None
-    (diffrax's own step)."""
-    return erk_tableau(cfg.solver)
-
-
-def _stepper(cfg: SweepConfig, opaque_true: Array | None = None) -> AbstractLaneStepper:
-    return make_stepper(
-        cfg.solver, cfg.contact_law, rtol=cfg.rtol, atol=cfg.atol, max_steps=cfg.max_steps,
-        stop_on_invalid=cfg.stop_on_invalid, opaque_true=opaque_true,
-    )  # fmt: skip
-
-
-def _section_times(pb: CeltParams, transient: Array, cfg: SweepConfig) -> Array:
-    """(L, S) stroboscopic times t0 + k 2 pi / omega_pi, k = transient, transient + 1, ..."""
-    dt = pb.omega_pi.dtype
-    T = 2 * jnp.pi / pb.omega_pi
-    S = cfg.sample_periods
-    return jnp.asarray(cfg.t0, dt) + T[:, None] * (transient.astype(dt) + jnp.arange(S, dtype=dt))[None, :]
 
 
 def _lyap_lane(p: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig) -> tuple[Array, Array]:
@@ -116,85 +72,6 @@ def _lyap_lane(p: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig) 
         max_steps=cfg.max_steps,  # per period: a bound, not a cost
     )
     return lr.exponent, lr.stderr
-
-
-def _pool_times(pb: CeltParams, transient: Array, cfg: SweepConfig, stepper: AbstractLaneStepper) -> Array:
-    """The section times the pool steps onto: float32 lanes of the fused step step in float64 time
-    (`FusedERKStepper`), so theirs come from float64 omega_pi."""
-    if isinstance(stepper, FusedERKStepper) and cfg.dtype != "float64":
-        pb = jax.tree_util.tree_map(lambda x: x.astype(jnp.float64), pb)
-    return _section_times(pb, transient, cfg)
-
-
-@functools.partial(jax.jit, static_argnames=("cfg", "width", "mesh", "vary"))
-def _pool_start(
-    pb: CeltParams, y0b: Array, live: Array, transient: Array, tols: Array, *, cfg: SweepConfig, width: int, mesh: Any,
-    vary: tuple[bool, ...],
-) -> PoolCarry:
-    """The pool's first program (per device): every lane's start (`start_lanes`) and the pool of
-    ``width`` slots filled (`begin_pool`), as a `carry_rows` carry. ``vary``: `split_lane_args`."""
-
-    def run(pb, y0b, live):
-        stepper = _stepper(cfg)
-        pv_all, params_of = split_lane_args(pb, vary)
-        t0 = jnp.asarray(cfg.t0, cfg.dtype)
-        lanes, samples = start_lanes(stepper, pv_all, params_of, y0b, _section_times(pb, transient, cfg), live, tols, t0)
-        ts_all = _pool_times(pb, transient, cfg, stepper)
-        if isinstance(stepper, FusedERKStepper) and cfg.dtype != "float64":
-            lanes = float64_times(lanes, ts_all[:, -1])
-        return carry_rows(begin_pool(lanes, samples, pv_all, ts_all, width=width))
-
-    return shard_lanes(run, mesh, 3)(pb, y0b, live)
-
-
-@functools.partial(jax.jit, static_argnames=("cfg", "mesh", "vary", "narrow_to"))
-def _pool_advance(
-    pb: CeltParams, carry: PoolCarry, pause_frac: Array, transient: Array, until: Array, opaque_true: Array | None,
-    *, cfg: SweepConfig, mesh: Any, vary: tuple[bool, ...], narrow_to: tuple[int, ...],
-) -> PoolCarry:
-    """The pool stepped on (per device, `advance_pool`): at its width until no more than ``until``
-    lanes have work left (``narrow_to`` empty), or through the drain's narrower widths
-    ``narrow_to`` to the end. ``opaque_true``: a traced True (a jit argument: XLA would fold a
-    constant predicate and the fused step's kernel boundaries would vanish), or None: no kernel
-    boundaries."""
-
-    def run(pb, carry):
-        stepper = _stepper(cfg, opaque_true)
-        pv_all, params_of = split_lane_args(pb, vary)
-        ts_all = _pool_times(pb, transient, cfg, stepper)
-        t0 = jnp.asarray(cfg.t0, cfg.dtype)
-        c = carry_from_rows(carry)
-        step = functools.partial(advance_pool, stepper, lane_args=pv_all, args_of=params_of, ts_all=ts_all, t0=t0,
-                                 pause_frac=pause_frac)  # fmt: skip
-        if not narrow_to:
-            c = step(c, until=until)
-        for w, nxt in zip(narrow_to, [*narrow_to[1:], 0]):
-            c = step(narrow_pool(c, w), until=nxt)
-        return carry_rows(c)
-
-    return shard_lanes(run, mesh, 2)(pb, carry)
-
-
-@functools.partial(jax.jit, static_argnames=("cfg", "mesh"))
-def _pool_outputs(
-    pb: CeltParams, lanes: LaneState, samples: Array, transient: Array, *, cfg: SweepConfig, mesh: Any
-) -> dict[str, Array]:
-    """The per-lane outputs from the pool's final lane table and samples (per device)."""
-
-    def run(pb, lanes, samples):
-        stepper = _stepper(cfg)
-        out = dict(lane_outputs(stepper, lanes).as_dict(), samples=samples, t_samples=_pool_times(pb, transient, cfg, stepper))
-        out.update(jax.vmap(_extras)(samples, pb))
-        return out
-
-    return shard_lanes(run, mesh, 3)(pb, lanes, samples)
-
-
-def _abstract(tree: Any, mesh: Any) -> Any:
-    """``tree``'s shapes (e.g. a lowered program's ``out_info``) with the lane-axis sharding of ``mesh``: a program taking
-    it is compiled for the arrays the pool's programs hand on."""
-    spec = None if mesh is None else jax.sharding.NamedSharding(mesh, jax.sharding.PartitionSpec(LANE_AXIS))
-    return jax.tree_util.tree_map(lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=spec), tree)
 
 
 @eqx.filter_jit
@@ -224,18 +101,18 @@ def _kernel_chunk(
         L = y0b.shape[0]
         pb = params_of(tuple(pv))
         pb = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(jnp.asarray(x, cfg.dtype), (L,)), pb)
-        stepper = _stepper(cfg, None)
-        ts_all = _section_times(pb, transient, cfg)
+        stepper = lane_stepper(cfg, None)
+        ts_all = section_times(pb, transient, cfg)
         t0 = jnp.asarray(cfg.t0, cfg.dtype)
         lanes, _ = start_lanes(stepper, tuple(pv), params_of, y0b, ts_all, live, tols, t0)
         seg = make_segment(cfg, params_of, len(pv))
         # the kernel's times are float64 (`jaxcelt.ensemble.kernel`): section times from the lanes' omega_pi
-        ts64 = _section_times(jax.tree_util.tree_map(lambda x: x.astype(jnp.float64), pb), transient, cfg)
+        ts64 = section_times(jax.tree_util.tree_map(lambda x: x.astype(jnp.float64), pb), transient, cfg)
         lanes = float64_times(lanes, ts64[:, -1])
         out, samples, iters = run_kernel_lanes(seg, lanes, tuple(pv), ts64, interpret)
         ts_all = ts64
         out = dict(out, samples=samples, t_samples=ts_all)
-        out.update(jax.vmap(_extras)(samples, pb))
+        out.update(jax.vmap(lane_extras)(samples, pb))
         return out, iters
 
     return shard_lanes(run, mesh, 3)(pv, y0b, live)
@@ -418,51 +295,12 @@ def _run_lanes(
             pool_lowered = _kernel_chunk.lower(*pool_args)
         pool_compiled = compile_later(pool_lowered.compile)
     else:
-        # the pool in three programs (`_pool_start`, `_pool_advance`, `_pool_outputs`), compiled
-        # at the same time on worker threads; the drain's narrower widths are a fourth program,
-        # compiled only when the lanes left are predicted to need it (`DRAIN_MIN_STEPS`)
-        widths = drain_widths(Wd, Lloc, int(drain_factor), int(min_drain_width))
-        y0_p = y0_np[pos_lane].astype(dt)
-        start_kw = dict(cfg=nocfg, width=Wd, mesh=mesh, vary=vary)
-        adv_kw = dict(cfg=nocfg, mesh=mesh, vary=vary)
-        pause, no_until = jnp.asarray(frac), jnp.asarray(0, jnp.int32)
-        with gc_paused():
-            start_lowered = _pool_start.lower(pb_p, y0_p, live, transient, tols, **start_kw)
-            carry_spec = _abstract(start_lowered.out_info, mesh)
-            wide_lowered = _pool_advance.lower(pb_p, carry_spec, pause, transient, no_until, opaque_true, narrow_to=(), **adv_kw)
-        wide_compiled = compile_later(functools.partial(wide_lowered.compile, pool_compiler_options(platform, Wd)))
-        start_compiled = compile_later(start_lowered.compile)
-        with gc_paused():
-            out_lowered = _pool_outputs.lower(pb_p, carry_spec.lanes, carry_spec.samples, transient, cfg=nocfg, mesh=mesh)
-        out_compiled = compile_later(out_lowered.compile)
-
-        def drain_program():
-            with gc_paused():
-                lowered = _pool_advance.lower(pb_p, carry_spec, pause, transient, no_until, opaque_true,
-                                              narrow_to=tuple(widths[1:]), **adv_kw)  # fmt: skip
-            return lowered.compile(pool_compiler_options(platform, widths[-1]))
-
-        def run_pool_programs():
-            drain_compiled = compile_later(drain_program) if compile_only and len(widths) > 1 else None
-            carry = start_compiled.result()(pb_p, y0_p, live, transient, tols)
-            wide = wide_compiled.result()
-            until = jnp.asarray(widths[1] if len(widths) > 1 else 0, jnp.int32)
-            carry = wide(pb_p, carry, pause, transient, until, opaque_true)
-            if len(widths) > 1 and np.any(np.asarray(carry.lane) < Lloc):
-                # the lanes left: through the narrow drain if they are predicted to need at least
-                # drain_min_steps more steps, else on at the full width (the same lanes either way)
-                left = float(jnp.max(remaining_steps(carry, float(nocfg.t0))))  # on the device: the slots only
-                if left >= drain_min_steps:
-                    if drain_compiled is None:
-                        drain_compiled = compile_later(drain_program)
-                    carry = drain_compiled.result()(pb_p, carry, pause, transient, no_until, opaque_true)
-                else:
-                    carry = wide(pb_p, carry, pause, transient, no_until, opaque_true)
-            out = out_compiled.result()(pb_p, carry.lanes, carry.samples, transient)
-            if drain_compiled is not None:  # compile_only: every program compiled before returning
-                drain_compiled.result()
-            return out, carry.iters, carry.slot_steps
-
+        # the pool's programs (`jaxcelt.ensemble.lane_programs`), sent to compile now; run below
+        run_pool_programs = prepare_pool(
+            pb_p, y0_np[pos_lane].astype(dt), live, transient, tols, cfg=nocfg, width=Wd, lanes_per_device=Lloc,
+            mesh=mesh, vary=vary, pause_frac=frac, opaque_true=opaque_true, platform=platform,
+            drain=(int(drain_factor), int(min_drain_width)), drain_min_steps=drain_min_steps, compile_only=compile_only,
+        )  # fmt: skip
     lyap_compiled = None
     if cfg.lyapunov_periods > 0 and not compile_only:
         example = (jax.tree_util.tree_map(lambda x: x[:1].repeat(G, 0), pb_np), np.zeros((G, 13)), np.zeros(G))
