@@ -112,7 +112,7 @@ class Segment:
     by the monitor (None: none)."""
 
     def __init__(self, cfg: Any, params_of: Any, nvary: int, dtype: Any, *, field: Any = None, n: int = 13,
-                 omega_of: Any = None, n3_index: int | None = 8):  # fmt: skip
+                 omega_of: Any = None, n3_index: int | None = 8, unroll: bool | None = None):  # fmt: skip
         tab = erk_tableau(cfg.solver)
         if tab is None:
             raise ValueError(
@@ -157,6 +157,10 @@ class Segment:
 
             self.rhs_jvp = blockwise(tangent, one, ex_y, ex_pv, one, ex_y)
         self.omega_of = omega_of
+        self.unroll = type(self).unroll if unroll is None else bool(unroll)
+
+    unroll = False
+    """the default of ``unroll``: the explicit stages in a loop (one copy of the field) or written out"""
 
     def field_time(self, t: Array, pv: tuple[Array, ...]) -> Array:
         """The time the field is evaluated at, in the field's dtype (`jaxcelt.physics.model.field_time`): the
@@ -244,7 +248,17 @@ class Segment:
             ks = [ks[0]] + [[jnp.where(i + 1 == j, new[m], ks[j][m]) for m in range(n)] for j in range(1, ns + 1)]
             return ks, yn, fn, N, den, yi, fi
 
-        ks, yi, fi, N, den, yp, fp = jax.lax.fori_loop(0, ns, stage, (ks, y0, f0, zero, zero, y0, f0))
+        if self.unroll:
+            # the stages written out: constant coefficients, the zero ones skipped, every stage's field its own copy
+            ks, yi, fi, yp, fp = ks[:1], y0, f0, y0, f0
+            for i in range(ns):
+                yn = [y0[m] + sum(float(self.a[i, j]) * ks[j][m] for j in range(i + 1) if self.a[i, j] != 0)
+                      for m in range(n)]  # fmt: skip
+                fn, N, den = self.field(t0 + self.c[i] * dt, yn, pv)
+                ks.append([f * dts for f in fn])
+                yp, fp, yi, fi = yi, fi, yn, fn
+        else:
+            ks, yi, fi, N, den, yp, fp = jax.lax.fori_loop(0, ns, stage, (ks, y0, f0, zero, zero, y0, f0))
         if self.fsal_is_y1:
             y1 = yi
         else:
