@@ -53,8 +53,8 @@ def main() -> int:
     ap.add_argument("--dtype", default="float64", choices=("float64", "float32"))
     ap.add_argument("--field-dtype", default=None, choices=("float32",), help="mixed precision: the field in float32")
     ap.add_argument("--stiffness", default="off", choices=("off", "auto"), help="the kernel's stiffness switch")
-    ap.add_argument("--stages", default="loop", choices=("loop", "unrolled"),
-                    help="the kernel's explicit stages in a loop or written out (`Segment.unroll`)")  # fmt: skip
+    ap.add_argument("--noise-factor", type=float, default=None,
+                    help="mixed precision: the field's rounding floor in the error control (`Segment.noise_factor`)")  # fmt: skip
     ap.add_argument("--omega", nargs=2, type=float, default=(10.0, 20.0), help="omega_pi range")
     ap.add_argument("--q", nargs=2, type=float, default=(0.02, 0.06), help="q_pi range")
     ap.add_argument("--rtol", type=float, default=1e-8)
@@ -90,7 +90,8 @@ def main() -> int:
     from jaxcelt.ensemble.kernel import Segment
     from jaxcelt.plotting.map import map_categories
 
-    Segment.unroll = a.stages == "unrolled"
+    if a.noise_factor is not None:
+        Segment.noise_factor = a.noise_factor
     from jaxcelt.provenance import load_average
     from jaxcelt.versions import versions
 
@@ -138,7 +139,7 @@ def main() -> int:
         "dtype": a.dtype,
         "field_dtype": a.field_dtype,
         "stiffness": a.stiffness,
-        "stages": a.stages,
+        "noise_factor": Segment.noise_factor if a.field_dtype else None,
         "omega_pi": list(a.omega),
         "q_pi": list(a.q),
         "rtol": a.rtol,

@@ -112,7 +112,7 @@ class Segment:
     by the monitor (None: none)."""
 
     def __init__(self, cfg: Any, params_of: Any, nvary: int, dtype: Any, *, field: Any = None, n: int = 13,
-                 omega_of: Any = None, n3_index: int | None = 8, unroll: bool | None = None):  # fmt: skip
+                 omega_of: Any = None, n3_index: int | None = 8):  # fmt: skip
         tab = erk_tableau(cfg.solver)
         if tab is None:
             raise ValueError(
@@ -157,10 +157,12 @@ class Segment:
 
             self.rhs_jvp = blockwise(tangent, one, ex_y, ex_pv, one, ex_y)
         self.omega_of = omega_of
-        self.unroll = type(self).unroll if unroll is None else bool(unroll)
+        low = self.fdtype != self.dtype
+        self.noise = float(type(self).noise_factor * np.finfo(self.fdtype).eps) if low else 0.0  # 0: no floor
 
-    unroll = False
-    """the default of ``unroll``: the explicit stages in a loop (one copy of the field) or written out"""
+    noise_factor = 0.0
+    """mixed precision: the field's rounding floor in the error estimate, in units of the field dtype's
+    eps times |h f| weighted by the estimate's coefficients (see `explicit`); 0 (default): none"""
 
     def field_time(self, t: Array, pv: tuple[Array, ...]) -> Array:
         """The time the field is evaluated at, in the field's dtype (`jaxcelt.physics.model.field_time`): the
@@ -248,22 +250,21 @@ class Segment:
             ks = [ks[0]] + [[jnp.where(i + 1 == j, new[m], ks[j][m]) for m in range(n)] for j in range(1, ns + 1)]
             return ks, yn, fn, N, den, yi, fi
 
-        if self.unroll:
-            # the stages written out: constant coefficients, the zero ones skipped, every stage's field its own copy
-            ks, yi, fi, yp, fp = ks[:1], y0, f0, y0, f0
-            for i in range(ns):
-                yn = [y0[m] + sum(float(self.a[i, j]) * ks[j][m] for j in range(i + 1) if self.a[i, j] != 0)
-                      for m in range(n)]  # fmt: skip
-                fn, N, den = self.field(t0 + self.c[i] * dt, yn, pv)
-                ks.append([f * dts for f in fn])
-                yp, fp, yi, fi = yi, fi, yn, fn
-        else:
-            ks, yi, fi, N, den, yp, fp = jax.lax.fori_loop(0, ns, stage, (ks, y0, f0, zero, zero, y0, f0))
+        ks, yi, fi, N, den, yp, fp = jax.lax.fori_loop(0, ns, stage, (ks, y0, f0, zero, zero, y0, f0))
         if self.fsal_is_y1:
             y1 = yi
         else:
             y1 = [y0[m] + sum(float(self.b[j]) * ks[j][m] for j in range(ns + 1) if self.b[j] != 0) for m in range(n)]
         err = [sum(float(self.e[j]) * ks[j][m] for j in range(ns + 1) if self.e[j] != 0) for m in range(n)]
+        if self.noise:
+            # a field of lower precision than the state: its rounding, ~ noise u |h f| in each stage, is
+            # in the error estimate too, which cannot resolve errors below it; compare the estimate with
+            # the tolerance plus that floor (as err tol / (tol + floor)), or components whose tolerance
+            # is atol alone cap the step far below what their truncation error needs
+            floor = [self.noise * sum(abs(float(self.e[j])) * jnp.abs(ks[j][m]) for j in range(ns + 1) if self.e[j] != 0)
+                     for m in range(n)]  # fmt: skip
+            tol = [self.atol + jnp.maximum(jnp.abs(a), jnp.abs(b)) * self.rtol for a, b in zip(y0, y1)]
+            err = [x * (t / (t + fl)) for x, t, fl in zip(err, tol, floor)]
         if self.stiff:
             num = sum((a - b) * (a - b) for a, b in zip(fi, fp))
             den2 = sum((a - b) * (a - b) for a, b in zip(yi, yp))
