@@ -53,8 +53,6 @@ def main() -> int:
     ap.add_argument("--dtype", default="float64", choices=("float64", "float32"))
     ap.add_argument("--field-dtype", default=None, choices=("float32",), help="mixed precision: the field in float32")
     ap.add_argument("--stiffness", default="off", choices=("off", "auto"), help="the kernel's stiffness switch")
-    ap.add_argument("--noise-factor", type=float, default=None,
-                    help="mixed precision: the field's rounding floor in the error control (`Segment.noise_factor`)")  # fmt: skip
     ap.add_argument("--omega", nargs=2, type=float, default=(10.0, 20.0), help="omega_pi range")
     ap.add_argument("--q", nargs=2, type=float, default=(0.02, 0.06), help="q_pi range")
     ap.add_argument("--rtol", type=float, default=1e-8)
@@ -87,11 +85,7 @@ def main() -> int:
 
     import jaxcelt as jc
     from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
-    from jaxcelt.ensemble.kernel import Segment
     from jaxcelt.plotting.map import map_categories
-
-    if a.noise_factor is not None:
-        Segment.noise_factor = a.noise_factor
     from jaxcelt.provenance import load_average
     from jaxcelt.versions import versions
 
@@ -139,7 +133,6 @@ def main() -> int:
         "dtype": a.dtype,
         "field_dtype": a.field_dtype,
         "stiffness": a.stiffness,
-        "noise_factor": Segment.noise_factor if a.field_dtype else None,
         "omega_pi": list(a.omega),
         "q_pi": list(a.q),
         "rtol": a.rtol,

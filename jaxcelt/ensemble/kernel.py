@@ -157,12 +157,6 @@ class Segment:
 
             self.rhs_jvp = blockwise(tangent, one, ex_y, ex_pv, one, ex_y)
         self.omega_of = omega_of
-        low = self.fdtype != self.dtype
-        self.noise = float(type(self).noise_factor * np.finfo(self.fdtype).eps) if low else 0.0  # 0: no floor
-
-    noise_factor = 0.0
-    """mixed precision: the field's rounding floor in the error estimate, in units of the field dtype's
-    eps times |h f| weighted by the estimate's coefficients (see `explicit`); 0 (default): none"""
 
     def field_time(self, t: Array, pv: tuple[Array, ...]) -> Array:
         """The time the field is evaluated at, in the field's dtype (`jaxcelt.physics.model.field_time`): the
@@ -256,15 +250,6 @@ class Segment:
         else:
             y1 = [y0[m] + sum(float(self.b[j]) * ks[j][m] for j in range(ns + 1) if self.b[j] != 0) for m in range(n)]
         err = [sum(float(self.e[j]) * ks[j][m] for j in range(ns + 1) if self.e[j] != 0) for m in range(n)]
-        if self.noise:
-            # a field of lower precision than the state: its rounding, ~ noise u |h f| in each stage, is
-            # in the error estimate too, which cannot resolve errors below it; compare the estimate with
-            # the tolerance plus that floor (as err tol / (tol + floor)), or components whose tolerance
-            # is atol alone cap the step far below what their truncation error needs
-            floor = [self.noise * sum(abs(float(self.e[j])) * jnp.abs(ks[j][m]) for j in range(ns + 1) if self.e[j] != 0)
-                     for m in range(n)]  # fmt: skip
-            tol = [self.atol + jnp.maximum(jnp.abs(a), jnp.abs(b)) * self.rtol for a, b in zip(y0, y1)]
-            err = [x * (t / (t + fl)) for x, t, fl in zip(err, tol, floor)]
         if self.stiff:
             num = sum((a - b) * (a - b) for a, b in zip(fi, fp))
             den2 = sum((a - b) * (a - b) for a, b in zip(yi, yp))
