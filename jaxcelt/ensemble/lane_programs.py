@@ -55,11 +55,11 @@ def lane_extras(ys: Array, p: CeltParams) -> dict[str, Array]:
     return dict(drift=drift, max_excursion=exc, r_O=r_O)
 
 
-def lane_stepper(cfg: SweepConfig, opaque_true: Array | None = None, stage_loop: bool = False) -> AbstractLaneStepper:
+def lane_stepper(cfg: SweepConfig, opaque_true: Array | None = None) -> AbstractLaneStepper:
     """The stepper of the sweep's solver (`jaxcelt.ensemble.make_stepper`)."""
     return make_stepper(
         cfg.solver, cfg.contact_law, rtol=cfg.rtol, atol=cfg.atol, max_steps=cfg.max_steps,
-        stop_on_invalid=cfg.stop_on_invalid, opaque_true=opaque_true, stage_loop=stage_loop,
+        stop_on_invalid=cfg.stop_on_invalid, opaque_true=opaque_true,
     )  # fmt: skip
 
 
@@ -112,9 +112,7 @@ def pool_advance(
     boundaries."""
 
     def run(pb, carry):
-        # at full width the stages run in a loop (one copy of the field: less to compile, as fast); the
-        # drain's narrow widths keep them written out, where a loop's overhead per stage would show
-        stepper = lane_stepper(cfg, opaque_true, stage_loop=not narrow_to)
+        stepper = lane_stepper(cfg, opaque_true)
         pv_all, params_of = split_lane_args(pb, vary)
         ts_all = pool_times(pb, transient, cfg, stepper)
         t0 = jnp.asarray(cfg.t0, cfg.dtype)

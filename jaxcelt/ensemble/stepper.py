@@ -250,9 +250,6 @@ class FusedERKStepper(AbstractLaneStepper):
     max_steps: int
     stop_on_invalid: bool
     opaque_true: Array | None = None
-    stage_loop: bool = False
-    """the stages after the first in a loop over the tableau's rows (one copy of the field in the program,
-    less to compile) instead of written out; the same arithmetic, so lanes agree to rounding"""
 
     def init(self, t0, y0, ts, p, tols):
         # the controller's first step needs no solver state: the fused step's state is the FSAL
@@ -275,15 +272,12 @@ class FusedERKStepper(AbstractLaneStepper):
         dts = dt.astype(y0.dtype)  # float32 lanes step in float64 time (`float64_times`); float64: no-op
         ks = [st.f * dts]
         float64 = y0.dtype == jnp.float64
-        if self.stage_loop:
-            ks, yi, fi, aux = self._stages_in_a_loop(ks[0], y0, t0, dt, dts, p, boundary)
-        else:
-            for c, a in zip(np.asarray(tab.c, dtype=float).tolist(), tab.a_lower):
-                yi = boundary(_combine(y0, a, ks))
-                # float32 lanes: the forcing phase from one period, not from t (`jaxcelt.physics.model.field_time`)
-                ti = t0 + c * dt if float64 else field_time(t0, p.omega_pi, y0.dtype, c * dt)
-                fi, aux = vector_field_and_normal(ti, yi, p, self.law)
-                ks.append(fi * dts)
+        for c, a in zip(np.asarray(tab.c, dtype=float).tolist(), tab.a_lower):
+            yi = boundary(_combine(y0, a, ks))
+            # float32 lanes: the forcing phase from one period, not from t (`jaxcelt.physics.model.field_time`)
+            ti = t0 + c * dt if float64 else field_time(t0, p.omega_pi, y0.dtype, c * dt)
+            fi, aux = vector_field_and_normal(ti, yi, p, self.law)
+            ks.append(fi * dts)
         b = np.asarray(tab.b_sol, dtype=float)
         fsal_is_y1 = b[-1] == 0.0 and np.array_equal(np.asarray(tab.a_lower[-1], dtype=float), b[:-1])
         y1 = yi if fsal_is_y1 else _combine(y0, b, ks)
@@ -350,37 +344,6 @@ class FusedERKStepper(AbstractLaneStepper):
             st.first_invalid_t, st.first_invalid_kind, st.min_N, jnp.arccos(jnp.clip(st.min_n3, -1, 1)), st.at_singularity
         )
 
-    def _stages_in_a_loop(
-        self, k0: Array, y0: Array, t0: Array, dt: Array, dts: Array, p: CeltParams, boundary: Callable[[Array], Array]
-    ) -> tuple[list[Array], Array, Array, Any]:
-        """The stages after the first in a loop over the tableau's rows (``stage_loop``): (the stages k_0 ... k_s,
-        the last stage's input and field, its (N, den)). Stage i's input is y0 + a_i0 k_0 + a_i1 k_1 + ... in
-        `_combine`'s order, the coefficients read from the tableau's row i (the stages not yet computed are zeros)."""
-        tab = self.tableau
-        ns = len(tab.c)
-        A = np.zeros((ns, ns + 1))
-        for i, row in enumerate(tab.a_lower):
-            A[i, : len(row)] = np.asarray(row, dtype=float)
-        cols = [j for j in range(ns) if A[:, j].any()]
-        float64 = y0.dtype == jnp.float64
-        A_, C_ = jnp.asarray(A, y0.dtype), jnp.asarray(np.asarray(tab.c, dtype=float))
-
-        def body(i, carry):
-            K = carry[0]
-            yi = y0
-            for j in cols:
-                yi = yi + A_[i, j] * K[j]
-            yi = boundary(yi)
-            c = C_[i]
-            ti = t0 + c * dt if float64 else field_time(t0, p.omega_pi, y0.dtype, c * dt)
-            fi, (N, den) = vector_field_and_normal(ti, yi, p, self.law)
-            return K.at[i + 1].set(fi * dts), yi, fi, N, den
-
-        K = jnp.zeros((ns + 1,) + y0.shape, y0.dtype).at[0].set(k0)
-        zero = jnp.zeros((), y0.dtype)
-        K, yi, fi, N, den = jax.lax.fori_loop(0, ns, body, (K, y0, y0, zero, zero))
-        return [K[j] for j in range(ns + 1)], yi, fi, (N, den)
-
 
 def float64_times(lanes: LaneState, t1: Array) -> LaneState:
     """Lanes (a batch) with their times in float64 and the state as it is: how `FusedERKStepper` steps
@@ -416,12 +379,11 @@ def make_stepper(
     max_steps: int,
     stop_on_invalid: bool,
     opaque_true: Array | None = None,
-    stage_loop: bool = False,
 ) -> AbstractLaneStepper:
     """The stepper for ``solver``: `FusedERKStepper` for an explicit FSAL tableau, else
     `DiffraxStepper`. ``rtol``/``atol`` fill an implicit solver's root-finder tolerances (as
-    `simulate` does); the step-size tolerances are the lanes' ``tols``. ``opaque_true``,
-    ``stage_loop``: see `FusedERKStepper`."""
+    `simulate` does); the step-size tolerances are the lanes' ``tols``. ``opaque_true``: see
+    `FusedERKStepper`."""
     law = get_contact_law(contact_law)
     wrapped = MonitoredSolver(solver=_fill_implicit_tols(solver, rtol, atol), law=law)
     term = wrap_term(diffrax.ODETerm(CeltField(law)))
@@ -437,5 +399,4 @@ def make_stepper(
         max_steps=max_steps,
         stop_on_invalid=stop_on_invalid,
         opaque_true=opaque_true,
-        stage_loop=stage_loop,
     )
