@@ -83,3 +83,48 @@ QUOTES = [
     (PAGE, load),
     (PAGE, scipy),
 ]
+
+RERUN = "docs/performance/numba_table_400x300_rerun.json"
+LOOP = "docs/performance/numba_table_400x300_stage_loop.json"
+
+
+def rerun() -> str:
+    """The final code's table again, in words."""
+    m = _json(RERUN)["modes"]
+    s, o = m["stop"], m["on"]
+    return (
+        f"stopping, jaxcelt warm {s['jaxcelt']['warm_s']:.1f} s against numba {s['numba']['warm_s']:.1f} s "
+        f"({s['warm_speedup_vs_numba']:.2f}×), first call {s['jaxcelt']['first_call_s']:.1f} s against "
+        f"{s['numba']['first_call_s']:.1f} s ({s['first_call_speedup_vs_numba']:.2f}×), a first call "
+        f"{s['first_call_minus_warm_jaxcelt_s']:.1f} s above a warm one; integrating on, warm {o['jaxcelt']['warm_s']:.1f} s "
+        f"against {o['numba']['warm_s']:.1f} s ({o['warm_speedup_vs_numba']:.2f}×), first call "
+        f"{o['jaxcelt']['first_call_s']:.1f} s against {o['numba']['first_call_s']:.1f} s "
+        f"({o['first_call_speedup_vs_numba']:.2f}×), {o['first_call_minus_warm_jaxcelt_s']:.1f} s above warm."
+    )
+
+
+def _advance_compile(path: str, mode: str) -> float:
+    log = _json(path)["modes"][mode]["jaxcelt"]["first_call_compile_log"]
+    return next(t for n, t in log if n == "XLA compilation of jit(pool_advance)")
+
+
+def stage_loop() -> str:
+    """The stages-in-a-loop run against the rerun, in words."""
+    a, b = _json(LOOP)["modes"], _json(RERUN)["modes"]
+    j = lambda m, k: (a[m]["jaxcelt"][k], b[m]["jaxcelt"][k])  # noqa: E731
+    return (
+        f"Stopping, it compiled `pool_advance` in {_advance_compile(LOOP, 'stop'):.1f} s against "
+        f"{_advance_compile(RERUN, 'stop'):.1f} s, but the first call was no faster ({j('stop', 'first_call_s')[0]:.1f} s "
+        f"against {j('stop', 'first_call_s')[1]:.1f} s; integrating on {j('on', 'first_call_s')[0]:.1f} s against "
+        f"{j('on', 'first_call_s')[1]:.1f} s) and the warm calls were slower ({j('stop', 'warm_s')[0]:.1f} s against "
+        f"{j('stop', 'warm_s')[1]:.1f} s; {j('on', 'warm_s')[0]:.1f} s against {j('on', 'warm_s')[1]:.1f} s). Its lanes "
+        f"agree to rounding (another program: {_sp(j('stop', 'lane_steps')[0])} against {_sp(j('stop', 'lane_steps')[1])} "
+        f"lane-steps stopping)."
+    )
+
+
+def _sp(n: int) -> str:
+    return f"{int(n):,}".replace(",", " ")
+
+
+QUOTES += [(PAGE, rerun), (PAGE, stage_loop)]
