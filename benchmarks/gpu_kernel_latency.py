@@ -31,6 +31,9 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from gpu_map import _append  # noqa: E402  (one JSON file of runs, each with its provenance)
+
 VARIANTS = ("float64", "mixed")
 
 
@@ -74,9 +77,8 @@ def main() -> int:
     pb = eqx.tree_at(lambda q: q.q_pi, lanes_params(p, "omega_pi", lane_x), jnp.asarray(lane_y))
     y0 = np.tile(np.asarray(jc.initial_state(p)), (L, 1))
     for name in a.variants:
-        precision = name
         cfg = SweepConfig(transient_periods=a.transient, sample_periods=a.sample, rtol=1e-8, atol=1e-10,
-                          stop_on_invalid=True, field_dtype="float32" if precision == "mixed" else None)  # fmt: skip
+                          stop_on_invalid=True, field_dtype="float32" if name == "mixed" else None)  # fmt: skip
         kw = dict(varying=("omega_pi", "q_pi"), engine="kernel")
         t = time.perf_counter()
         run_lanes(pb, y0, cfg, compile_only=True, **kw)
@@ -113,14 +115,6 @@ def main() -> int:
         print(json.dumps({k: v for k, v in rec.items() if k != "versions"}), flush=True)
         _append(a.json, rec, load0)
     return 0
-
-
-def _append(path: Path, rec: dict, load_at_start: list[float] | None) -> None:
-    from jaxcelt.provenance import provenance, write_result
-
-    recs = json.loads(path.read_text())["runs"] if path.exists() else []
-    recs.append(rec | {"provenance": provenance(load_at_start=load_at_start)})
-    write_result(path, {"runs": recs}, load_at_start=load_at_start)
 
 
 if __name__ == "__main__":

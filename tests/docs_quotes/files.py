@@ -22,6 +22,11 @@ def _json(rel: str):
     return json.loads((ROOT / rel).read_text(encoding="utf-8"))
 
 
+def _sp(n) -> str:
+    """An integer as the documents write it: thousands apart by spaces (1 234 567)."""
+    return f"{round(n):,}".replace(",", " ")
+
+
 def _bench():
     return _json("docs/bifurcation/bench_sweep_400x300.json")
 

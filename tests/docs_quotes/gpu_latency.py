@@ -4,7 +4,7 @@ docs/performance/gpu_map_h200_rerun.json and gpu_map_noise_floor_h200.json), eac
 
 from __future__ import annotations
 
-from .files import _json
+from .files import _json, _sp
 
 BIF = "docs/bifurcation/README.md"
 LABELS = {
@@ -13,9 +13,6 @@ LABELS = {
     "mixed-loop": "float32 field (mixed), stages in a loop",
 }
 
-
-def _sp(n) -> str:
-    return f"{int(n):,}".replace(",", " ")
 
 
 def _lat(name: str) -> dict:

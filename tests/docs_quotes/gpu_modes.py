@@ -3,14 +3,11 @@ ensemble anchor (``benchmarks/gpu_map.py``, ``benchmarks/gpu_ensemble.py``)."""
 
 from __future__ import annotations
 
-from .files import _json
+from .files import _json, _sp
 
 BIF = "docs/bifurcation/README.md"
 PERF = "docs/performance.md"
 
-
-def _sp(n) -> str:
-    return f"{int(n):,}".replace(",", " ")
 
 
 def _maps() -> list[dict]:

@@ -8,7 +8,7 @@ Each entry is (document, function returning the quoted text).
 
 from __future__ import annotations
 
-from .files import _json
+from .files import _json, _sp
 
 PAGE = "docs/internals/sweep-engine.md"
 AFTER = "docs/performance/numba_table_400x300.json"
@@ -122,9 +122,6 @@ def stage_loop() -> str:
         f"lane-steps stopping)."
     )
 
-
-def _sp(n: int) -> str:
-    return f"{int(n):,}".replace(",", " ")
 
 
 QUOTES += [(PAGE, rerun), (PAGE, stage_loop)]
