@@ -85,7 +85,7 @@ def main() -> int:
         jax.config.update("jax_enable_x64", True)
     import jax.numpy as jnp
 
-    from jaxcelt.provenance import load_average
+    from jaxcelt.provenance import append_run, load_average
     from jaxcelt.versions import versions
 
     load0 = load_average()
@@ -126,16 +126,8 @@ def main() -> int:
             rec["engines"]["diffrax"]["best_ms"] / rec["engines"]["kernel"]["best_ms"], 2
         )
     print(json.dumps({k: v for k, v in rec.items() if k != "versions"}), flush=True)
-    _append(a.json, rec, load0)
+    append_run(a.json, rec, load_at_start=load0)
     return 0
-
-
-def _append(path: Path, rec: dict, load_at_start) -> None:
-    from jaxcelt.provenance import provenance, write_result
-
-    recs = json.loads(path.read_text())["runs"] if path.exists() else []
-    recs.append(rec | {"provenance": provenance(load_at_start=load_at_start)})
-    write_result(path, {"runs": recs}, load_at_start=load_at_start)
 
 
 if __name__ == "__main__":

@@ -32,7 +32,6 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from gpu_map import _append  # noqa: E402  (one JSON file of runs, each with its provenance)
 
 VARIANTS = ("float64", "mixed")
 
@@ -64,7 +63,7 @@ def main() -> int:
 
     import jaxcelt as jc
     from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
-    from jaxcelt.provenance import load_average
+    from jaxcelt.provenance import append_run, load_average
     from jaxcelt.versions import versions
 
     load0 = load_average()
@@ -113,7 +112,7 @@ def main() -> int:
             "versions": ver,
         }
         print(json.dumps({k: v for k, v in rec.items() if k != "versions"}), flush=True)
-        _append(a.json, rec, load0)
+        append_run(a.json, rec, load_at_start=load0)
     return 0
 
 

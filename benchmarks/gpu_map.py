@@ -67,8 +67,10 @@ def main() -> int:
     ap.add_argument("--check-dtypes", nargs="+", default=["float64"], choices=("float64", "float32"))
     a = ap.parse_args()
     if a.compare:
+        from jaxcelt.provenance import append_run
+
         rec = compare(*a.compare)
-        _append(a.json, {"comparison": rec})
+        append_run(a.json, {"comparison": rec})
         return 0
 
     import tempfile
@@ -79,14 +81,16 @@ def main() -> int:
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
     jax.config.update("jax_persistent_cache_min_entry_size_bytes", 0)
     if a.check:
+        from jaxcelt.provenance import append_run
+
         rec = check(a)
-        _append(a.json, {"check": rec})
+        append_run(a.json, {"check": rec})
         return 0
 
     import jaxcelt as jc
     from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
     from jaxcelt.plotting.map import map_categories
-    from jaxcelt.provenance import load_average
+    from jaxcelt.provenance import append_run, load_average
     from jaxcelt.versions import versions
 
     load0 = load_average()
@@ -151,7 +155,7 @@ def main() -> int:
         "regime_counts": {label: int(np.sum(cat == i)) for i, (label, _) in enumerate(cats) if np.any(cat == i)},
     }
     print(json.dumps(rec), flush=True)
-    _append(a.json, rec, load_at_start=load0)
+    append_run(a.json, rec, load_at_start=load0)
     if a.labels:
         a.labels.parent.mkdir(parents=True, exist_ok=True)
         np.savez_compressed(a.labels, category=cat, status=status, omega_pi=xs, q_pi=ys)
@@ -204,16 +208,6 @@ def check(a) -> dict:
         }
         print(json.dumps({dtype: rec[dtype]}), flush=True)
     return rec
-
-
-def _append(path: Path, rec: dict, load_at_start: list[float] | None = None) -> None:
-    from jaxcelt.provenance import provenance, write_result
-
-    recs = json.loads(path.read_text()) if path.exists() else {"runs": []}
-    recs = recs if isinstance(recs, list) else recs["runs"]  # a list: a file of the script's earlier versions
-    # each record keeps its own run's provenance: the file gathers runs of several processes (and machines)
-    recs.append(rec | {"provenance": provenance(load_at_start=load_at_start)})
-    write_result(path, {"runs": recs}, load_at_start=load_at_start)
 
 
 if __name__ == "__main__":

@@ -154,6 +154,37 @@ def write_result(
     return path
 
 
+def append_run(
+    path: str | os.PathLike,
+    run: dict[str, Any],
+    *,
+    load_at_start: list[float] | None = None,
+) -> Path:
+    """Append ``run`` to the list ``"runs"`` of the result file at ``path`` (written through ``write_result``).
+
+    For benchmarks whose file gathers runs of several processes or machines: each run keeps its own
+    ``"provenance"``, and the file's top-level provenance is that of the last write. A file that holds a bare
+    list (an older layout) is read as that list of runs. Returns the path written.
+
+    Raises:
+        ValueError: ``path`` exists but is not a result file of runs (it is left as it is).
+    """
+    if not isinstance(run, dict):
+        raise ValueError(f"run: a run must be a dict (a JSON object), got {type(run).__name__}")
+    path = Path(path)
+    runs: list = []
+    if path.exists():
+        try:
+            old = json.loads(path.read_text(encoding="utf-8"))
+        except json.JSONDecodeError as e:
+            raise ValueError(f"path: {path} is not valid JSON ({e}); move it aside to start a new file") from None
+        runs = old if isinstance(old, list) else old.get("runs") if isinstance(old, dict) else None
+        if not isinstance(runs, list):
+            raise ValueError(f"path: {path} holds no list of runs; move it aside to start a new file")
+    runs = [*runs, {**run, "provenance": provenance(load_at_start=load_at_start)}]
+    return write_result(path, {"runs": runs}, load_at_start=load_at_start)
+
+
 def _default(x):
     """numpy and JAX scalars and arrays in result dicts."""
     if hasattr(x, "tolist"):

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import jaxcelt
-from jaxcelt.provenance import load_average, provenance, write_result
+from jaxcelt.provenance import append_run, load_average, provenance, write_result
 
 ROOT = Path(__file__).resolve().parents[1]
 FROM_CHECKOUT = (ROOT / ".git").exists() and Path(jaxcelt.__file__).resolve().is_relative_to(ROOT)
@@ -77,6 +77,33 @@ def test_write_result_default_and_failure(tmp_path):
     assert not path.exists()
 
 
+def test_append_run_keeps_earlier_runs_each_with_its_provenance(tmp_path):
+    path = tmp_path / "runs.json"
+    append_run(path, {"x": 1}, load_at_start=[0.5, 0.5, 0.5])
+    append_run(path, {"x": 2})
+    got = json.loads(path.read_text())
+    assert [r["x"] for r in got["runs"]] == [1, 2]
+    assert got["runs"][0]["provenance"]["load_average_at_start"] == [0.5, 0.5, 0.5]
+    assert "load_average_at_start" not in got["runs"][1]["provenance"]
+    assert "machine" in got["provenance"]
+    # the older layout, a bare list of runs, is read as that list
+    old = tmp_path / "old.json"
+    old.write_text(json.dumps([{"x": 0}]))
+    append_run(old, {"x": 1})
+    assert [r["x"] for r in json.loads(old.read_text())["runs"]] == [0, 1]
+
+
+@pytest.mark.parametrize("text", ['{"runs": [1', '{"other": 1}', '"text"'])
+def test_append_run_leaves_a_file_it_cannot_read_alone(tmp_path, text):
+    path = tmp_path / "runs.json"
+    path.write_text(text)
+    with pytest.raises(ValueError, match="path: "):
+        append_run(path, {"x": 1})
+    assert path.read_text() == text
+    with pytest.raises(ValueError, match="run: "):
+        append_run(tmp_path / "new.json", [1])
+
+
 # --- every result file of the benchmarks and the study scripts goes through write_result -------------------------
 
 SCRIPTS = sorted(
@@ -136,4 +163,6 @@ def test_result_files_written_through_write_result(path):
     src = path.read_text(encoding="utf-8")
     names_json = re.search(r"""\.json["']""", src) is not None
     if names_json and path.name not in READERS:
-        assert "write_result(" in src, f"{path.name} names a .json file but never calls write_result"
+        assert "write_result(" in src or "append_run(" in src, (
+            f"{path.name} names a .json file but never calls write_result or append_run"
+        )
