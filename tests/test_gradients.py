@@ -156,3 +156,29 @@ def test_grad_wrt_one_traced_leaf_under_jit(paper_params):
 
     g = jax.grad(loss)(paper_params.mu)
     assert np.isfinite(g)
+
+
+def test_unmonitored_forward_mode_solve_matches_the_monitored_one():
+    """``monitor=False`` (the fit's solves) drops the validity monitor and nothing else: the same trajectory,
+    status and forward-mode tangents as the monitored solve. Two different compiled programs, so compared to
+    1e-12 relative rather than bitwise (the same step sequence; only XLA's fusion of the states may differ)."""
+    y0 = jnp.asarray(_y0_rocking())
+
+    def ys(theta, monitor):
+        p = P0.replace(**{k: theta[i] for i, k in enumerate(NAMES)})
+        sol = jc.simulate(p, y0, T1, ts=TS, adjoint=diffrax.ForwardMode(), monitor=monitor)
+        return sol.ys, sol
+
+    (J0, s0), (J1, s1) = (
+        jax.jacfwd(lambda th, m=m: ys(th, m), has_aux=True)(jnp.asarray(THETA0)) for m in (True, False)
+    )
+    y_0, y_1 = s0.ys, s1.ys
+    assert s1.validity is None and int(s0.validity.first_invalid_kind) == 0
+    assert int(s1.status) == int(s0.status) == 0 and int(s1.num_steps) == int(s0.num_steps)
+    scale = np.max(np.abs(np.asarray(y_0)))
+    assert np.max(np.abs(np.asarray(y_1) - np.asarray(y_0))) <= 1e-12 * scale
+    jscale = np.max(np.abs(np.asarray(J0)))
+    assert np.max(np.abs(np.asarray(J1) - np.asarray(J0))) <= 1e-12 * jscale
+    with pytest.raises(ValueError, match="validity"):
+        _ = s1.valid
+    assert "not monitored" in s1.summary()

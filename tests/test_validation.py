@@ -216,6 +216,7 @@ def test_bad_tolerances(which, value):
         (dict(rtol=np.array([1e-8, 1e-8])), "rtol"),
         (dict(dtype="int32"), "dtype"),
         (dict(contact_law="no_such_law"), "law"),
+        (dict(monitor=1), "monitor"),
     ],
 )
 def test_bad_solver_arguments(kwargs, name):

@@ -14,6 +14,7 @@ per iteration). Both return a `Trace`: the final unknowns and the per-iteration 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 from collections.abc import Callable
 
@@ -120,6 +121,17 @@ def _lsq_step_batch(zs, states, frozen, solver, prob):
     return eqx.filter_vmap(one)(zs, states, frozen)
 
 
+@functools.cache
+def _optax_optimiser(name: str, learning_rate: float, max_iter: int) -> optax.GradientTransformation:
+    """A cache: the optax optimiser of these settings. One object per settings, so that `_optax_step` (which takes
+    the optimiser's functions as static arguments, compared by identity) is compiled once per process, not per fit."""
+    if name == "adam":
+        # cosine decay to 1e-3 of the initial step over the budget: constant-step Adam hovers
+        # around the optimum at a distance ~ learning_rate instead of converging
+        return optax.adam(optax.cosine_decay_schedule(learning_rate, max_iter, alpha=1e-3))
+    return optax.lbfgs()
+
+
 @eqx.filter_jit
 def _optax_step(z, opt_state, optimiser, prob, linesearch: bool):
     loss_fn = lambda x: _loss(x, prob)  # noqa: E731
@@ -182,14 +194,11 @@ def run(prob: Problem, zf: Array, config: FitOptions, t_start: float) -> Trace:
             if _deadline(config, t_start, iter_marks[-1]):
                 break
     else:
-        if config.optimiser == "adam":
-            # cosine decay to 1e-3 of the initial step over the budget: constant-step Adam hovers
-            # around the optimum at a distance ~ learning_rate instead of converging
-            opt = optax.adam(optax.cosine_decay_schedule(config.learning_rate, config.max_iter, alpha=1e-3))
-        else:
-            opt = optax.lbfgs()
+        opt = _optax_optimiser(config.optimiser, config.learning_rate, config.max_iter)
         prefetch(prob, zf)
-        opt_state = opt.init(zf)
+        # strongly typed like the states `_optax_step` returns (optax's init leaves some weakly typed): one
+        # compilation of the step, not a second one at the second iteration
+        opt_state = jax.tree.map(lambda x: jnp.asarray(x, dtype=x.dtype), opt.init(zf))
         g0 = None
         for it in range(config.max_iter):
             with evaluating(prob):

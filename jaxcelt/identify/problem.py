@@ -157,6 +157,7 @@ class Problem(eqx.Module):
                 atol=self.atol,
                 max_steps=self.max_steps,
                 adjoint=adjoint,
+                monitor=False,  # the residuals never read validity: a smaller program to trace and compile
             )
             return sol.ys, sol.status
 
