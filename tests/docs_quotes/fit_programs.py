@@ -1,0 +1,66 @@
+"""Quotes of "Measured side by side: the optimisers' programs and the unmonitored solve" in the fit engine's page,
+computed from ``docs/fit/programs_ab/`` (``benchmarks/bench_fit.py --optimisers lm lbfgs``, three runs on each of
+two commits, alternately)."""
+
+from __future__ import annotations
+
+import statistics
+
+from .files import _json
+
+FE = "docs/internals/fit-engine.md"
+BEFORE, AFTER = "ea7532f", "6d479ed"
+
+
+def _runs(commit: str) -> list[dict]:
+    out = []
+    for i in (1, 2, 3):
+        d = _json(f"docs/fit/programs_ab/bench_fit_{commit}_{i}.json")
+        assert d["provenance"]["commit"].startswith(commit) and not d["provenance"]["dirty"]
+        out.append({(r["optimiser"], r["noise"]): r for r in d["rows"]})
+    return out
+
+
+def _med(commit: str, opt: str, noise: float) -> float:
+    return statistics.median(r[(opt, noise)]["fit_total_s"] for r in _runs(commit))
+
+
+def _span(commit: str) -> str:
+    v = [r[("lm", 0.0)]["fit_total_s"] for r in _runs(commit)]
+    return f"{min(v):.2f}–{max(v):.2f} s"
+
+
+def _same() -> str:
+    rs = _runs(BEFORE) + _runs(AFTER)
+    assert all(r[k]["converged"] for r in rs for k in r)
+    lm = {r[("lm", 0.0)]["n_iter"] for r in rs}
+    lb = {r[("lbfgs", 0.0)]["n_iter"] for r in rs}
+    err = {f"{r[k]['max_rel_err_vs_true']:.1e}" for r in rs for k in (("lm", 0.0), ("lbfgs", 0.0))}
+    assert len(lm) == len(lb) == len(err) == 1
+    return f"(LM and L-BFGS in {lm.pop()} and {lb.pop()} iterations, {err.pop()} off the truth without noise)"
+
+
+def _row(label: str, opt: str, noise: float) -> str:
+    return f"| {label} | {_med(BEFORE, opt, noise):.2f} s | {_med(AFTER, opt, noise):.2f} s |"
+
+
+def _ratio() -> str:
+    r = [_med(c, "lbfgs", 0.0) / _med(c, "lm", 0.0) for c in (BEFORE, AFTER)]
+    return f"| L-BFGS cold / LM cold | {r[0]:.2f}× | {r[1]:.2f}× |"
+
+
+QUOTES = [
+    (FE, _same),
+    (FE, lambda: _row("LM, no noise, cold", "lm", 0.0)),
+    (FE, lambda: _row("L-BFGS, no noise, cold", "lbfgs", 0.0)),
+    (FE, lambda: _row("L-BFGS, 1 % noise, second in the process", "lbfgs", 0.01)),
+    (FE, _ratio),
+    (FE, lambda: f"(LM cold {_span(BEFORE)} on ea7532f, {_span(AFTER)} on 6d479ed)"),
+]
+
+SETTINGS = [
+    (FE, "run three times alternately on commit ea7532f"),
+    (FE, "2 cores, on a slower day"),
+    (FE, "the 1 %-noise fit, which runs second"),
+    (FE, "L-BFGS is now within 1.5× of LM"),
+]
