@@ -1,6 +1,6 @@
 """Quotes of "Measured side by side: the optimisers' programs and the unmonitored solve" in the fit engine's page,
 computed from ``docs/fit/programs_ab/`` (``benchmarks/bench_fit.py --optimisers lm lbfgs``, three runs on each of
-two commits, alternately)."""
+two commits, alternately; ``--optimisers lm``, five runs on each; ``benchmarks/fit_compile_parts.py``, three on each)."""
 
 from __future__ import annotations
 
@@ -49,6 +49,45 @@ def _ratio() -> str:
     return f"| L-BFGS cold / LM cold | {r[0]:.2f}× | {r[1]:.2f}× |"
 
 
+LM_NEW = "2f69375"
+
+
+def _lm(commit: str) -> list[dict]:
+    out = []
+    for i in range(1, 6):
+        d = _json(f"docs/fit/programs_ab/bench_fit_lm_{commit}_{i}.json")
+        assert d["provenance"]["commit"].startswith(commit) and not d["provenance"]["dirty"]
+        out.append(next(r for r in d["rows"] if r["optimiser"] == "lm" and r["noise"] == 0.0))
+    return out
+
+
+def _lm_rows() -> tuple[str, str]:
+    cells = []
+    for c in (BEFORE, LM_NEW):
+        v = [r["fit_total_s"] for r in _lm(c)]
+        cells.append(f"{statistics.median(v):.2f} s ({min(v):.2f}–{max(v):.2f} s)")
+    comp = [f"{statistics.median(r['compile_s'] for r in _lm(c)):.2f} s" for c in (BEFORE, LM_NEW)]
+    return f"| whole fit, median (range) | {cells[0]} | {cells[1]} |", f"| of which compilation, median | {comp[0]} | {comp[1]} |"
+
+
+def _parts(commit: str, key: str) -> float:
+    v = []
+    for i in (1, 2, 3):
+        d = _json(f"docs/fit/programs_ab/compile_parts_{commit}_{i}.json")
+        assert d["provenance"]["commit"].startswith(commit) and not d["provenance"]["dirty"]
+        v.append(d["modes"]["nan-options"]["first_process"][key])
+    return statistics.median(v)
+
+
+def _parts_text() -> str:
+    t = [_parts(c, "trace_lower_s") for c in (LM_NEW, BEFORE)]
+    k = [_parts(c, "compile_s") for c in (LM_NEW, BEFORE)]
+    return (
+        f"traces and lowers in {t[0]:.2f} s against {t[1]:.2f} s and compiles in {k[0]:.2f} s against "
+        f"{k[1]:.2f} s (medians)"
+    )
+
+
 QUOTES = [
     (FE, _same),
     (FE, lambda: _row("LM, no noise, cold", "lm", 0.0)),
@@ -56,6 +95,9 @@ QUOTES = [
     (FE, lambda: _row("L-BFGS, 1 % noise, second in the process", "lbfgs", 0.01)),
     (FE, _ratio),
     (FE, lambda: f"(LM cold {_span(BEFORE)} on ea7532f, {_span(AFTER)} on 6d479ed)"),
+    (FE, lambda: _lm_rows()[0]),
+    (FE, lambda: _lm_rows()[1]),
+    (FE, lambda: " ".join(_parts_text().split())),
 ]
 
 SETTINGS = [
@@ -63,4 +105,8 @@ SETTINGS = [
     (FE, "2 cores, on a slower day"),
     (FE, "the 1 %-noise fit, which runs second"),
     (FE, "L-BFGS is now within 1.5× of LM"),
+    (FE, "Five more alternating pairs"),
+    (FE, "the second commit 2f69375 has the fit\ncode of 6d479ed"),
+    (FE, "| LM, no noise, cold (5 runs each) | ea7532f | 2f69375 |"),
+    (FE, "three alternating pairs in the same\nhour"),
 ]
