@@ -198,7 +198,7 @@ def run(prob: Problem, zf: Array, config: FitOptions, t_start: float) -> Trace:
         prefetch(prob, zf)
         # strongly typed like the states `_optax_step` returns (optax's init leaves some weakly typed): one
         # compilation of the step, not a second one at the second iteration
-        opt_state = jax.tree.map(lambda x: jnp.asarray(x, dtype=x.dtype), opt.init(zf))
+        opt_state = jax.tree.map(lambda x: jnp.asarray(x, dtype=jnp.asarray(x).dtype), opt.init(zf))
         g0 = None
         for it in range(config.max_iter):
             with evaluating(prob):
