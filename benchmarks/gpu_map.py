@@ -66,9 +66,9 @@ def main() -> int:
     ap.add_argument("--check", action="store_true", help="kernel against pool on a small map of cheap lanes")
     ap.add_argument("--check-dtypes", nargs="+", default=["float64"], choices=("float64", "float32"))
     a = ap.parse_args()
-    if a.compare:
-        from jaxcelt.provenance import append_run
+    from jaxcelt.provenance import append_run
 
+    if a.compare:
         rec = compare(*a.compare)
         append_run(a.json, {"comparison": rec})
         return 0
@@ -81,8 +81,6 @@ def main() -> int:
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
     jax.config.update("jax_persistent_cache_min_entry_size_bytes", 0)
     if a.check:
-        from jaxcelt.provenance import append_run
-
         rec = check(a)
         append_run(a.json, {"check": rec})
         return 0
@@ -90,7 +88,7 @@ def main() -> int:
     import jaxcelt as jc
     from jaxcelt.ensemble import SweepConfig, lanes_params, run_lanes
     from jaxcelt.plotting.map import map_categories
-    from jaxcelt.provenance import append_run, load_average
+    from jaxcelt.provenance import load_average
     from jaxcelt.versions import versions
 
     load0 = load_average()

@@ -12,13 +12,19 @@ FE = "docs/internals/fit-engine.md"
 BEFORE, AFTER = "ea7532f", "6d479ed"
 
 
-def _runs(commit: str) -> list[dict]:
+def _ab(name: str, commit: str, n: int) -> list[dict]:
+    """The ``n`` result files ``docs/fit/programs_ab/{name}_{commit}_{i}.json``, each checked to come from a clean
+    checkout of ``commit``."""
     out = []
-    for i in (1, 2, 3):
-        d = _json(f"docs/fit/programs_ab/bench_fit_{commit}_{i}.json")
+    for i in range(1, n + 1):
+        d = _json(f"docs/fit/programs_ab/{name}_{commit}_{i}.json")
         assert d["provenance"]["commit"].startswith(commit) and not d["provenance"]["dirty"]
-        out.append({(r["optimiser"], r["noise"]): r for r in d["rows"]})
+        out.append(d)
     return out
+
+
+def _runs(commit: str) -> list[dict]:
+    return [{(r["optimiser"], r["noise"]): r for r in d["rows"]} for d in _ab("bench_fit", commit, 3)]
 
 
 def _med(commit: str, opt: str, noise: float) -> float:
@@ -53,12 +59,7 @@ LM_NEW = "2f69375"
 
 
 def _lm(commit: str) -> list[dict]:
-    out = []
-    for i in range(1, 6):
-        d = _json(f"docs/fit/programs_ab/bench_fit_lm_{commit}_{i}.json")
-        assert d["provenance"]["commit"].startswith(commit) and not d["provenance"]["dirty"]
-        out.append(next(r for r in d["rows"] if r["optimiser"] == "lm" and r["noise"] == 0.0))
-    return out
+    return [next(r for r in d["rows"] if r["noise"] == 0.0) for d in _ab("bench_fit_lm", commit, 5)]
 
 
 def _lm_rows() -> tuple[str, str]:
@@ -71,12 +72,7 @@ def _lm_rows() -> tuple[str, str]:
 
 
 def _parts(commit: str, key: str) -> float:
-    v = []
-    for i in (1, 2, 3):
-        d = _json(f"docs/fit/programs_ab/compile_parts_{commit}_{i}.json")
-        assert d["provenance"]["commit"].startswith(commit) and not d["provenance"]["dirty"]
-        v.append(d["modes"]["nan-options"]["first_process"][key])
-    return statistics.median(v)
+    return statistics.median(d["modes"]["nan-options"]["first_process"][key] for d in _ab("compile_parts", commit, 3))
 
 
 def _parts_text() -> str:
