@@ -4,6 +4,7 @@ pinned ones, the names still exist, and the adapted loop takes diffeqsolve's ste
 If a diffrax or equinox release breaks one of these, the lane pool (`jaxcelt.ensemble`) would no
 longer take `jaxcelt.simulate`'s steps: these tests name the cause before the sweep tests fail."""
 
+import functools
 import importlib.metadata
 import tomllib
 from pathlib import Path
@@ -58,6 +59,56 @@ def test_clip_helpers_match_diffrax():
             _, got = ad.clip_to_end(*args, t1, floor, jnp.asarray(keep))
             want = _clip_to_end(jnp.minimum(args[0], t1), args[1], t1, floor, jnp.asarray(keep))
             assert float(got) == float(want), (tprev, tnext, keep)
+
+
+def _nextafter_count(jaxpr) -> int:
+    """How many nextafter operations a jaxpr holds, sub-jaxprs (loops, custom derivatives, calls) included."""
+    count = 0
+    for eqn in jaxpr.eqns:
+        count += eqn.primitive.name == "nextafter"
+        for sub in jax.extend.core.jaxprs_in_params(eqn.params):
+            count += _nextafter_count(sub)
+    return count
+
+
+def test_compact_end_rounding_same_threshold_fewer_operations():
+    import diffrax._integrate as integrate
+
+    with ad.compact_end_rounding():
+        # inside the block, the 100 chained calls of diffeqsolve's loop give t1 - 100 ULP, counted with numpy
+        for t1 in (1.0, 3.7, 1234.5, -2.5):
+            x = jnp.asarray(t1)
+            for _ in range(100):
+                x = integrate.eqxi.prevbefore(x)
+            want = np.float64(t1)
+            for _ in range(100):
+                want = np.nextafter(want, -np.inf)
+            assert float(x) == want, t1
+    # outside it, one call is one step (equinox's own prevbefore)
+    assert float(integrate.eqxi.prevbefore(jnp.asarray(1.0))) == np.nextafter(1.0, -np.inf)
+
+    def solve(field, t1, y0):
+        # each program its own vector field (both kept alive): diffeqsolve's trace is not reused between them
+        sol = diffrax.diffeqsolve(
+            diffrax.ODETerm(field),
+            diffrax.Tsit5(), 0.0, t1, None, y0, jnp.asarray(4.0),
+            saveat=diffrax.SaveAt(ts=jnp.linspace(0.0, 5.0, 6)),
+            stepsize_controller=diffrax.PIDController(rtol=1e-8, atol=1e-10),
+        )  # fmt: skip
+        return sol.ys
+
+    args = (jnp.asarray(5.0), jnp.array([1.0, 0.0]))  # t1 traced: the threshold is computed in the program
+    field_plain, field_compact = (lambda t, y, a: _forced_oscillator(t, y, a)), (lambda t, y, a: _forced_oscillator(t, y, a))
+    plain = jax.make_jaxpr(functools.partial(solve, field_plain))(*args)
+    with ad.compact_end_rounding():
+        compact = jax.make_jaxpr(functools.partial(solve, field_compact))(*args)
+    assert _nextafter_count(plain.jaxpr) >= 100  # diffrax's unrolled chain
+    assert _nextafter_count(compact.jaxpr) <= 2
+    # the same solve: two compiled programs, so to rounding (1e-13 of states of order 1), though the threshold,
+    # and so every step, is the same
+    ys_plain = jax.core.eval_jaxpr(plain.jaxpr, plain.consts, *args)[0]
+    ys_compact = jax.core.eval_jaxpr(compact.jaxpr, compact.consts, *args)[0]
+    np.testing.assert_allclose(np.asarray(ys_compact), np.asarray(ys_plain), rtol=0, atol=1e-13)
 
 
 def _forced_oscillator(t, y, args):
