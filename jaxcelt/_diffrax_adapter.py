@@ -5,7 +5,8 @@ jaxcelt uses diffrax's public API everywhere except where it has to reproduce wh
 solves side by side in its own while loop and must take the same steps as `diffeqsolve`, the
 Lyapunov exponent's per-period solves take them in a smaller program (`solve_to`), and
 `jaxcelt.integrate.solve` passes diffrax's "use the step-size tolerances" marker to an implicit solver's
-root finder. The names below are not re-exported by diffrax or equinox, or mirror the body of
+root finder. Every `diffrax.diffeqsolve` of jaxcelt goes through `diffeqsolve` here, which computes diffeqsolve's
+end-of-interval threshold by a loop instead of 100 unrolled steps (`compact_end_rounding`). The names below are not re-exported by diffrax or equinox, or mirror the body of
 diffrax's integration loop (``diffrax/_integrate.py``: ``loop``, ``body_fun_aux``,
 ``_clip_to_end``), so they can change in any release. The versions they were written against
 are the ranges pinned in ``pyproject.toml``; ``tests/test_ensemble_adapter.py`` checks that the
@@ -40,6 +41,7 @@ __all__ = [
     "solve_to",
     "runtime_checks_as_nan",
     "compact_end_rounding",
+    "diffeqsolve",
 ]
 
 
@@ -148,6 +150,13 @@ def compact_end_rounding():
             raise RuntimeError("diffeqsolve's t1 - 100 ULP chain ended early; compact_end_rounding is out of date")
     finally:
         _PENDING.n = outer
+
+
+def diffeqsolve(*args: Any, **kwargs: Any) -> diffrax.Solution:
+    """`diffrax.diffeqsolve` traced inside `compact_end_rounding`: the same solve, a smaller program. Every solve
+    jaxcelt makes with diffeqsolve goes through here."""
+    with compact_end_rounding():
+        return diffrax.diffeqsolve(*args, **kwargs)
 
 
 def clip_to_end(tprev: Array, tnext: Array, t1: Array, floor: Array, keep: Array) -> tuple[Array, Array]:

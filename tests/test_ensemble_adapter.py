@@ -211,3 +211,14 @@ def test_runtime_checks_as_nan_removes_host_callbacks():
     assert np.isnan(comp(jnp.asarray(-1.0))) and comp(jnp.asarray(2.0)) == 3.0
     with pytest.raises(Exception, match="x must be >= 0"):
         jax.jit(lambda x: f(x) * 2.0)(jnp.asarray(-1.0))
+
+
+def test_every_diffeqsolve_goes_through_the_adapter():
+    # jaxcelt's solves call the adapter's diffeqsolve (t1 - 100 ULP by a loop), never diffrax's directly
+    root = Path(ad.__file__).parent
+    direct = [
+        str(f.relative_to(root))
+        for f in root.rglob("*.py")
+        if f.name != "_diffrax_adapter.py" and "diffrax.diffeqsolve(" in f.read_text()
+    ]
+    assert direct == []

@@ -32,6 +32,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxcelt import _config  # noqa: F401
+from jaxcelt._diffrax_adapter import diffeqsolve
 from jaxcelt._types import Array, ArrayLike, Scalar, ScalarLike, Vec3
 from jaxcelt.integrate.solve import Solution, Validity, status_code
 from jaxcelt.physics.model import contact_geometry, horizontal_frame
@@ -122,7 +123,7 @@ class _NSField(eqx.Module):
 @eqx.filter_jit
 def _solve_noslip(p, z0, t0, t1, ts, rtol, atol, *, solver, max_steps):
     saveat = diffrax.SaveAt(ts=ts) if ts is not None else diffrax.SaveAt(t0=True, t1=True)
-    sol = diffrax.diffeqsolve(
+    sol = diffeqsolve(
         diffrax.ODETerm(_NSField()),
         solver,
         t0,

@@ -38,6 +38,7 @@ import jax.numpy as jnp
 import optimistix as optx
 
 from jaxcelt import _config  # noqa: F401
+from jaxcelt._diffrax_adapter import diffeqsolve
 from jaxcelt._types import Array, Scalar
 from jaxcelt.orbits.options import ShootingKeywords, ShootingOptions, resolve_options
 
@@ -92,7 +93,7 @@ def _flow(field, y0, args, *, period, k, t0, options: ShootingOptions, forward_m
     solver = options.solver or diffrax.Dopri8()
     t0 = jnp.asarray(t0, dtype)
     t1 = t0 + k * jnp.asarray(period, dtype)
-    return diffrax.diffeqsolve(
+    return diffeqsolve(
         diffrax.ODETerm(field),
         _forward_mode_solver(solver) if forward_mode else solver,
         t0,

@@ -20,6 +20,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from jaxcelt._diffrax_adapter import diffeqsolve
 from jaxcelt.orbits.shooting import find_periodic_orbit
 from jaxcelt.sweeps.continuation_core import LaneBatch, Refined, SectionModel, _identity
 from jaxcelt.sweeps.continuation_options import ContinuationOptions
@@ -39,7 +40,7 @@ def _lanes(field, solver, y0s, args, period, transient, n_samples, rtol, atol, m
     ts = (transient + jnp.arange(n_samples)) * period
 
     def one(y0):
-        sol = diffrax.diffeqsolve(
+        sol = diffeqsolve(
             diffrax.ODETerm(field), solver, t0=0.0, t1=ts[-1], dt0=None, y0=y0, args=args,
             saveat=diffrax.SaveAt(ts=ts), stepsize_controller=diffrax.PIDController(rtol=rtol, atol=atol),
             max_steps=max_steps, throw=False,
