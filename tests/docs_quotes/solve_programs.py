@@ -1,0 +1,103 @@
+"""Quotes of the compilation page (``docs/internals/compilation.md``): diffeqsolve's end-of-interval threshold by a
+loop, measured side by side on two commits, alternately: ``benchmarks/bench_fit.py --optimisers lm`` (five runs on
+each, ``docs/fit/programs_ab/bench_fit_lm_*``) and ``benchmarks/orbit_compile.py`` (three on each,
+``docs/orbits/compile_ab/``)."""
+
+from __future__ import annotations
+
+import statistics
+
+from .files import _json
+
+PAGE = "docs/internals/compilation.md"
+BEFORE, AFTER = "c2eb159", "8ea00d0"
+
+
+def _files(pattern: str, commit: str, n: int) -> list[dict]:
+    """The ``n`` result files ``pattern.format(commit=commit, i=i)``, each checked to come from a clean checkout of
+    ``commit``."""
+    out = []
+    for i in range(1, n + 1):
+        d = _json(pattern.format(commit=commit, i=i))
+        assert d["provenance"]["commit"].startswith(commit) and not d["provenance"]["dirty"]
+        out.append(d)
+    return out
+
+
+def _lm(commit: str) -> list[dict]:
+    return [
+        next(r for r in d["rows"] if r["noise"] == 0.0)
+        for d in _files("docs/fit/programs_ab/bench_fit_lm_{commit}_{i}.json", commit, 5)
+    ]
+
+
+def _orbit(commit: str) -> list[dict]:
+    return _files("docs/orbits/compile_ab/orbit_compile_{commit}_{i}.json", commit, 3)
+
+
+def _med(values) -> float:
+    return statistics.median(values)
+
+
+def _fit_rows() -> list[str]:
+    rows = []
+    for label, key in (("whole fit", "fit_total_s"), ("of which compilation", "compile_s"), ("iterations", "run_s")):
+        cells = []
+        for c in (BEFORE, AFTER):
+            v = [r[key] for r in _lm(c)]
+            cells.append(f"{_med(v):.2f} s ({min(v):.2f}–{max(v):.2f} s)")
+        rows.append(f"| {label} | {cells[0]} | {cells[1]} |")
+    return rows
+
+
+def _fit_same() -> str:
+    rs = _lm(BEFORE) + _lm(AFTER)
+    assert all(r["converged"] for r in rs)
+    iters = {r["n_iter"] for r in rs}
+    err = {f"{r['max_rel_err_vs_true']:.1e}" for r in rs}
+    assert len(iters) == len(err) == 1
+    return f"every run took {iters.pop()} iterations to the same values ({err.pop()} off the truth)"
+
+
+def _program(d: dict, name: str) -> float:
+    return sum(s for n, s in d["xla_over_0_2_s"] if n == f"jit({name})")
+
+
+def _orbit_rows() -> list[str]:
+    rows = []
+    for label, f in (
+        ("`periodic_orbit` + `continue_orbit`, wall", lambda d: d["periodic_orbit_s"] + d["continue_orbit_s"]),
+        ("XLA compilation, all programs", lambda d: d["xla_total_s"]),
+        ("of which `jit(_orbit)`", lambda d: _program(d, "_orbit")),
+        ("`jit(corrector)`", lambda d: _program(d, "corrector")),
+        ("`jit(multipliers)`", lambda d: _program(d, "multipliers")),
+        ("`jit(tangent)`", lambda d: _program(d, "tangent")),
+    ):
+        cells = [f"{_med(f(d) for d in _orbit(c)):.1f} s" for c in (BEFORE, AFTER)]
+        rows.append(f"| {label} | {cells[0]} | {cells[1]} |")
+    return rows
+
+
+def _orbit_same() -> str:
+    ds = _orbit(BEFORE) + _orbit(AFTER)
+    steps = {d["newton_steps"] for d in ds}
+    points = {d["branch_points"] for d in ds}
+    mults = {tuple(f"{m:.6f}" for m in d["multipliers_abs"]) for d in ds}
+    assert len(steps) == len(points) == len(mults) == 1
+    return f"the same orbit on both commits (Newton steps {steps.pop()}, branch points {points.pop()}, multipliers"
+
+
+QUOTES = [
+    *[(PAGE, lambda i=i: _fit_rows()[i]) for i in range(3)],
+    (PAGE, _fit_same),
+    *[(PAGE, lambda i=i: _orbit_rows()[i]) for i in range(6)],
+    (PAGE, _orbit_same),
+]
+
+SETTINGS = [
+    (PAGE, "five times alternately"),
+    (PAGE, "three times alternately"),
+    (PAGE, "omega_pi = 15.6 rad/s"),
+    (PAGE, "to 15.7 rad/s"),
+    (PAGE, "exactly as 0.7 does"),
+]
