@@ -66,8 +66,11 @@ def _nextafter_count(jaxpr) -> int:
     count = 0
     for eqn in jaxpr.eqns:
         count += eqn.primitive.name == "nextafter"
-        for sub in jax.extend.core.jaxprs_in_params(eqn.params):
-            count += _nextafter_count(sub)
+        for value in eqn.params.values():
+            for sub in value if isinstance(value, (tuple, list)) else (value,):
+                sub = getattr(sub, "jaxpr", sub)  # a ClosedJaxpr's jaxpr
+                if hasattr(sub, "eqns"):
+                    count += _nextafter_count(sub)
     return count
 
 
