@@ -5,9 +5,10 @@ jaxcelt uses diffrax's public API everywhere except where it has to reproduce wh
 solves side by side in its own while loop and must take the same steps as `diffeqsolve`, the
 Lyapunov exponent's per-period solves take them in a smaller program (`solve_to`), and
 `jaxcelt.integrate.solve` passes diffrax's "use the step-size tolerances" marker to an implicit solver's
-root finder. Every `diffrax.diffeqsolve` of jaxcelt goes through `diffeqsolve` here, which computes diffeqsolve's
-end-of-interval threshold by a loop instead of 100 unrolled steps (`compact_end_rounding`). The names below are not re-exported by diffrax or equinox, or mirror the body of
-diffrax's integration loop (``diffrax/_integrate.py``: ``loop``, ``body_fun_aux``,
+root finder. Every `diffrax.diffeqsolve` of jaxcelt goes through `diffeqsolve` here, which
+computes diffeqsolve's end-of-interval threshold by a loop instead of 100 unrolled steps
+(`compact_end_rounding`). The names below are not re-exported by diffrax or equinox, or mirror
+the body of diffrax's integration loop (``diffrax/_integrate.py``: ``loop``, ``body_fun_aux``,
 ``_clip_to_end``), so they can change in any release. The versions they were written against
 are the ranges pinned in ``pyproject.toml``; ``tests/test_ensemble_adapter.py`` checks that the
 installed diffrax and equinox are inside them, that the names still exist, and that

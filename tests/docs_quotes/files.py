@@ -22,6 +22,17 @@ def _json(rel: str):
     return json.loads((ROOT / rel).read_text(encoding="utf-8"))
 
 
+def _runs_of(pattern: str, commit: str, n: int) -> list[dict]:
+    """The ``n`` result files ``pattern.format(commit=commit, i=i)`` (i = 1 .. n) of an alternating A/B, each checked
+    to come from a clean checkout of ``commit``."""
+    out = []
+    for i in range(1, n + 1):
+        d = _json(pattern.format(commit=commit, i=i))
+        assert d["provenance"]["commit"].startswith(commit) and not d["provenance"]["dirty"], (pattern, commit, i)
+        out.append(d)
+    return out
+
+
 def _sp(n) -> str:
     """An integer as the documents write it: thousands apart by spaces (1 234 567)."""
     return f"{round(n):,}".replace(",", " ")

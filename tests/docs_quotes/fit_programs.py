@@ -6,21 +6,15 @@ from __future__ import annotations
 
 import statistics
 
-from .files import _json
+from .files import _runs_of
 
 FE = "docs/internals/fit-engine.md"
 BEFORE, AFTER = "ea7532f", "6d479ed"
 
 
 def _ab(name: str, commit: str, n: int) -> list[dict]:
-    """The ``n`` result files ``docs/fit/programs_ab/{name}_{commit}_{i}.json``, each checked to come from a clean
-    checkout of ``commit``."""
-    out = []
-    for i in range(1, n + 1):
-        d = _json(f"docs/fit/programs_ab/{name}_{commit}_{i}.json")
-        assert d["provenance"]["commit"].startswith(commit) and not d["provenance"]["dirty"]
-        out.append(d)
-    return out
+    """The ``n`` result files ``docs/fit/programs_ab/{name}_{commit}_{i}.json`` of a clean checkout of ``commit``."""
+    return _runs_of(f"docs/fit/programs_ab/{name}_{{commit}}_{{i}}.json", commit, n)
 
 
 def _runs(commit: str) -> list[dict]:

@@ -7,32 +7,21 @@ from __future__ import annotations
 
 import statistics
 
-from .files import _json
+from .files import _runs_of
 
 PAGE = "docs/internals/compilation.md"
 BEFORE, AFTER = "c2eb159", "8ea00d0"
 
 
-def _files(pattern: str, commit: str, n: int) -> list[dict]:
-    """The ``n`` result files ``pattern.format(commit=commit, i=i)``, each checked to come from a clean checkout of
-    ``commit``."""
-    out = []
-    for i in range(1, n + 1):
-        d = _json(pattern.format(commit=commit, i=i))
-        assert d["provenance"]["commit"].startswith(commit) and not d["provenance"]["dirty"]
-        out.append(d)
-    return out
-
-
 def _lm(commit: str) -> list[dict]:
     return [
         next(r for r in d["rows"] if r["noise"] == 0.0)
-        for d in _files("docs/fit/programs_ab/bench_fit_lm_{commit}_{i}.json", commit, 5)
+        for d in _runs_of("docs/fit/programs_ab/bench_fit_lm_{commit}_{i}.json", commit, 5)
     ]
 
 
 def _orbit(commit: str) -> list[dict]:
-    return _files("docs/orbits/compile_ab/orbit_compile_{commit}_{i}.json", commit, 3)
+    return _runs_of("docs/orbits/compile_ab/orbit_compile_{commit}_{i}.json", commit, 3)
 
 
 def _med(values) -> float:
