@@ -23,6 +23,12 @@ fusion emitters, and it runs as fast or faster (``benchmarks/fit_compile_parts.p
 ``docs/performance/compile_options.json``). Results agree to rounding (another compiled
 program). Other platforms get XLA's defaults.
 
+The lane pool's first and last programs (`jaxcelt.ensemble.lane_programs.pool_start`, ``pool_outputs``) run once per
+chunk of lanes, so their compile time is all they cost: on a CPU they get the loop emitters too (their step, the
+stepper's initialisation, is the same arithmetic; see docs/internals/compilation.md for the main job's compile time
+with and without). The pool's stepping program keeps the default emitters or the wide vectors above: it is where
+the run time goes.
+
 JAX takes compiler options only on a top-level ``jax.jit``, so they are given to programs that
 are never called inside another trace: the fit's evaluation program and the sweep's Lyapunov
 stage (not `jaxcelt.simulate`, which users call inside their own ``jit``, ``vmap`` and ``grad``).
@@ -36,7 +42,8 @@ WIDE_VECTORS_MIN_SLOTS = 64
 
 
 def compiler_options(platform: str) -> dict | None:
-    """The options for a program compiled for ``platform`` (``"cpu"``, ``"gpu"``, ...)."""
+    """The options for a program compiled for ``platform`` (``"cpu"``, ``"gpu"``, ...) that holds a differentiated
+    solve or runs once per job (the loop emitters on a CPU)."""
     return dict(LOOP_EMITTERS) if platform == "cpu" else None
 
 

@@ -18,7 +18,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxcelt._compile_options import pool_compiler_options
+from jaxcelt._compile_options import compiler_options, pool_compiler_options
 from jaxcelt._executable_cache import compile_later, gc_paused
 from jaxcelt._types import Array
 from jaxcelt.ensemble.config import SweepConfig
@@ -185,10 +185,11 @@ def prepare_pool(
         carry_spec = _abstract(start_lowered.out_info, mesh)
         wide_lowered = pool_advance.lower(pb, carry_spec, pause, transient, no_until, opaque_true, narrow_to=(), **adv_kw)
     wide_compiled = compile_later(functools.partial(wide_lowered.compile, pool_compiler_options(platform, width)))
-    start_compiled = compile_later(start_lowered.compile)
+    # the first and last programs run once per chunk: compiled for compile time (`jaxcelt._compile_options`)
+    start_compiled = compile_later(functools.partial(start_lowered.compile, compiler_options(platform)))
     with gc_paused():
         out_lowered = pool_outputs.lower(pb, carry_spec.lanes, carry_spec.samples, transient, cfg=cfg, mesh=mesh)
-    out_compiled = compile_later(out_lowered.compile)
+    out_compiled = compile_later(functools.partial(out_lowered.compile, compiler_options(platform)))
 
     def drain_program():
         with gc_paused():
