@@ -9,14 +9,16 @@ shared cores): 14-320 s each; the longest is must show 3 (321 s at load ~10).
 """
 
 import dataclasses
+import time
 
 import jax.numpy as jnp
 import numpy as np
 import pytest
 
 import jaxcelt as jc
-from jaxcelt.identify import program
+from jaxcelt.identify import api, program
 from jaxcelt.identify.chaos import gradient_norm_vs_window
+from jaxcelt.identify.optimisers import run
 from jaxcelt.identify.options import FitOptions
 from jaxcelt.identify.problem import build_problem, residuals, value_and_jacobian
 from jaxcelt.identify.records import generate_data, save_data
@@ -95,6 +97,24 @@ def test_lm_recovers_imu_short_record(short_imu):
     # the same compiled step (no retrace: same shapes and settings) under a spent time budget
     short = jc.fit(data, PAPER, free=FREE, optimiser="lm", max_iter=60, max_time=0.0)
     assert short.n_iter == 1 and not short.converged
+
+
+def test_fit_ends_on_the_optimisers_own_evaluation(short_imu, monkeypatch):
+    """The (r, J) at a fit's final unknowns (its loss, standard errors, correlations) is the optimiser's own evaluation
+    there: no solve repeated. The same settings as the LM test above, so the compiled programs are re-used."""
+    data = short_imu.subset(["omega"])
+    config = FitOptions(free=FREE, optimiser="lm", max_iter=60)
+    prob, zf = api.prepare(data, PAPER, config)
+    trace = run(prob, zf, config, time.perf_counter())
+    assert trace.final is not None
+    r, J = program.evaluate(prob, trace.zf)
+    # the same compiled program at the same unknowns; asserted to rounding (1e-12 of the largest entry), not bitwise
+    np.testing.assert_allclose(trace.final[0], r, rtol=0, atol=1e-12 * np.abs(r).max())
+    np.testing.assert_allclose(trace.final[1], J, rtol=0, atol=1e-12 * np.abs(J).max())
+    calls = []
+    monkeypatch.setattr(api, "evaluate", lambda *a: calls.append(a) or program.evaluate(*a))
+    res = jc.fit(data, PAPER, options=config)
+    assert calls == [] and res.converged
 
 
 def test_vmapped_multistart_equals_sequential_fits(short_imu):

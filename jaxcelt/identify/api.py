@@ -86,5 +86,6 @@ def fit_with(data: MeasuredData, params0: CeltParams, config: FitOptions) -> Fit
     prob, zf = prepare(data, params0, config)
     t_start = time.perf_counter()
     trace = run(prob, zf, config, t_start)
-    r, J = evaluate(prob, np.asarray(trace.zf))
+    # (r, J) at the final unknowns: the optimiser's own evaluation there, else one more
+    r, J = trace.final if trace.final is not None else evaluate(prob, np.asarray(trace.zf))
     return make_result(prob, trace, r, J, config, t_start)

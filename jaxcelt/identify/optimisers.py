@@ -29,7 +29,7 @@ from jaxcelt import _config  # noqa: F401
 from jaxcelt._types import Array
 from jaxcelt.identify.options import LSQ_OPTIMISERS, FitOptions
 from jaxcelt.identify.problem import Problem, theta_and_jacobian, thetas, to_device
-from jaxcelt.identify.program import callback_value_and_jacobian, evaluating, prefetch
+from jaxcelt.identify.program import callback_value_and_jacobian, evaluating, kept_key, prefetch
 
 __all__ = ["DampedGaussNewton", "Trace", "run", "run_batch", "lsq_solver"]
 
@@ -156,6 +156,8 @@ class Trace:
     param_history: list[dict[str, float]]
     converged: bool
     iter_marks: list[float]
+    final: tuple[np.ndarray, np.ndarray] | None = None
+    """(r, J) at ``zf`` where the optimiser evaluated it (None: it did not)."""
 
 
 def _deadline(config: FitOptions, t_start: float, now: float) -> bool:
@@ -171,19 +173,28 @@ def run(prob: Problem, zf: Array, config: FitOptions, t_start: float) -> Trace:
         th = np.asarray(theta_and_jacobian(prob, zf)[0])
         return {n: float(th[i]) for i, n in enumerate(free)}
 
+    def keep_only(zf) -> None:  # of the evaluations so far, the one at the current iterate
+        entry = kept.get(kept_key(zf))
+        kept.clear()
+        if entry is not None:
+            kept[kept_key(zf)] = entry
+
     loss_hist, par_hist = [], []
+    kept: dict = {}
     converged = False
     iter_marks = [time.perf_counter()]
     if config.optimiser in LSQ_OPTIMISERS:
         solver = lsq_solver(config.optimiser, config.rtol, config.atol)
         prefetch(prob, zf)
+        values_of(zf)  # its small program compiles now, while the evaluation program compiles in the background
         with evaluating(prob):
             state = jax.block_until_ready(_lsq_init(zf, solver, prob))
         for it in range(config.max_iter):
-            with evaluating(prob):
+            with evaluating(prob, kept):
                 z_new, state, loss_acc, done, ok = jax.block_until_ready(_lsq_step(zf, state, solver, prob))
             iter_marks.append(time.perf_counter())
             zf = z_new
+            keep_only(zf)
             loss_hist.append(float(loss_acc))
             par_hist.append(values_of(zf))
             if callback is not None:
@@ -196,15 +207,17 @@ def run(prob: Problem, zf: Array, config: FitOptions, t_start: float) -> Trace:
     else:
         opt = _optax_optimiser(config.optimiser, config.learning_rate, config.max_iter)
         prefetch(prob, zf)
+        values_of(zf)  # compiled while the evaluation program compiles in the background
         # strongly typed like the states `_optax_step` returns (optax's init leaves some weakly typed): one
         # compilation of the step, not a second one at the second iteration
         opt_state = jax.tree.map(lambda x: jnp.asarray(x, dtype=jnp.asarray(x).dtype), opt.init(zf))
         g0 = None
         for it in range(config.max_iter):
-            with evaluating(prob):
+            with evaluating(prob, kept):
                 step = _optax_step(zf, opt_state, opt, prob, config.optimiser == "lbfgs")
                 z_new, opt_state, value, gnorm = jax.block_until_ready(step)
             iter_marks.append(time.perf_counter())
+            keep_only(zf)  # the step evaluated at zf (and at line-search points)
             loss_hist.append(float(value))
             par_hist.append(values_of(zf))
             if callback is not None:
@@ -220,7 +233,8 @@ def run(prob: Problem, zf: Array, config: FitOptions, t_start: float) -> Trace:
             zf = z_new
             if _deadline(config, t_start, iter_marks[-1]):
                 break
-    return Trace(np.asarray(zf), loss_hist, par_hist, converged, iter_marks)
+    zf = np.asarray(zf)
+    return Trace(zf, loss_hist, par_hist, converged, iter_marks, kept.get(kept_key(zf)))
 
 
 def run_batch(prob: Problem, starts: np.ndarray, config: FitOptions, t_start: float) -> list[Trace]:
