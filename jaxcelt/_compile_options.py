@@ -30,11 +30,16 @@ with and without). The pool's stepping program keeps the default emitters or the
 the run time goes.
 
 JAX takes compiler options only on a top-level ``jax.jit``, so they are given to programs that
-are never called inside another trace: the fit's evaluation program and the sweep's Lyapunov
-stage (not `jaxcelt.simulate`, which users call inside their own ``jit``, ``vmap`` and ``grad``).
+are never called inside another trace: the fit's evaluation program and its optimisers' step programs (small
+programs with a host callback, which gain nothing from the fusion emitters either), the sweep's Lyapunov stage
+(`jit_per_platform`), not `jaxcelt.simulate`, which users call inside their own ``jit``, ``vmap`` and ``grad``.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
+
+import equinox as eqx
 
 LOOP_EMITTERS = {"xla_cpu_use_fusion_emitters": False}
 WIDE_VECTORS = {"xla_cpu_prefer_vector_width": 512}
@@ -45,6 +50,14 @@ def compiler_options(platform: str) -> dict | None:
     """The options for a program compiled for ``platform`` (``"cpu"``, ``"gpu"``, ...) that holds a differentiated
     solve or runs once per job (the loop emitters on a CPU)."""
     return dict(LOOP_EMITTERS) if platform == "cpu" else None
+
+
+def jit_per_platform(fn: Callable) -> Callable[[str], Callable]:
+    """``fn`` as one ``equinox.filter_jit`` program per kind of platform, each compiled with `compiler_options` of
+    its platform: ``jit_per_platform(fn)(platform)`` is the jitted ``fn`` to call on ``platform``. Only for programs
+    called at top level (JAX takes compiler options there alone)."""
+    jits = {kind: eqx.filter_jit(fn, compiler_options=compiler_options(kind)) for kind in ("cpu", "other")}
+    return lambda platform: jits["cpu" if platform == "cpu" else "other"]
 
 
 def is_wide_pool(platform: str, slots: int) -> bool:

@@ -24,7 +24,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxcelt import _config  # noqa: F401
-from jaxcelt._compile_options import compiler_options, is_wide_pool
+from jaxcelt._compile_options import is_wide_pool, jit_per_platform
 from jaxcelt._executable_cache import compile_later, gc_paused, start_deferred
 from jaxcelt._types import Array
 from jaxcelt.ensemble.config import ENGINES, SweepConfig, check_engine
@@ -127,10 +127,7 @@ def _lyap_chunk_impl(
 
 # the Lyapunov stage (a diffrax solve with its tangent, vmapped over lanes), per platform: on a CPU
 # compiled with XLA's loop emitters (`jaxcelt._compile_options`)
-_lyap_chunk = {
-    platform: eqx.filter_jit(_lyap_chunk_impl, compiler_options=compiler_options(platform))
-    for platform in ("cpu", "other")
-}
+_lyap_chunk = jit_per_platform(_lyap_chunk_impl)
 
 
 def varying_names(pb: CeltParams) -> set[str]:
@@ -281,7 +278,7 @@ def _run_lanes(
     if is_wide_pool(platform, Wd):  # the contact law's form for wide batches (vectorised logarithm)
         nocfg = dataclasses.replace(nocfg, contact_law=get_contact_law(nocfg.contact_law).wide_batch())
     G = Wd * ndev  # the Lyapunov stage's chunk: the pool's width (a chunk of few lanes solves no padding copies)
-    lyap_fn = _lyap_chunk["cpu" if platform == "cpu" else "other"]
+    lyap_fn = _lyap_chunk(platform)
     # The pool's programs and the Lyapunov stage's are traced here, one after the other, and
     # compiled by XLA on worker threads at the same time (XLA releases the GIL while compiling); all
     # are then called as compiled programs. Later chunks of the same shapes find them in JAX's caches.

@@ -26,6 +26,7 @@ import optax
 import optimistix as optx
 
 from jaxcelt import _config  # noqa: F401
+from jaxcelt._compile_options import jit_per_platform
 from jaxcelt._types import Array
 from jaxcelt.identify.options import LSQ_OPTIMISERS, FitOptions
 from jaxcelt.identify.problem import Problem, theta_and_jacobian, thetas, to_device
@@ -88,23 +89,26 @@ def lsq_solver(name: str, rtol: float, atol: float):
 
 
 
-@eqx.filter_jit
-def _lsq_init(z, solver, prob):
+def _lsq_init_impl(z, solver, prob):
     f_struct = jax.ShapeDtypeStruct((prob.n_residuals,), z.dtype)
     return solver.init(_lsq_fn, z, prob, {}, f_struct, None, frozenset())
 
 
-@eqx.filter_jit
-def _lsq_step(z, state, solver, prob):
+def _lsq_step_impl(z, state, solver, prob):
     z, state, _ = solver.step(_lsq_fn, z, prob, {}, state, frozenset())
     done, result = solver.terminate(_lsq_fn, z, prob, {}, state, frozenset())
     # loss at the last accepted iterate; whether the termination is a success
     return z, state, 0.5 * jnp.sum(state.f_info.residual**2), done, result == optx.RESULTS.successful
 
 
+# the optimisers' step programs (one start), with `jaxcelt._compile_options.compiler_options` of the platform
+_lsq_init = jit_per_platform(_lsq_init_impl)
+_lsq_step = jit_per_platform(_lsq_step_impl)
+
+
 @eqx.filter_jit
 def _lsq_init_batch(zs, solver, prob):
-    return eqx.filter_vmap(lambda z: _lsq_init(z, solver, prob))(zs)
+    return eqx.filter_vmap(lambda z: _lsq_init_impl(z, solver, prob))(zs)
 
 
 @eqx.filter_jit
@@ -112,7 +116,7 @@ def _lsq_step_batch(zs, states, frozen, solver, prob):
     """One step of every start; a start that has terminated (``frozen``) keeps its iterate and state."""
 
     def one(z, state, stop):
-        z2, state2, loss, done, ok = _lsq_step(z, state, solver, prob)
+        z2, state2, loss, done, ok = _lsq_step_impl(z, state, solver, prob)
         keep = lambda a, b: jnp.where(stop, a, b) if eqx.is_array(a) else b  # noqa: E731
         z2 = jnp.where(stop, z, z2)
         state2 = jax.tree.map(keep, state, state2, is_leaf=lambda x: x is None)
@@ -132,8 +136,7 @@ def _optax_optimiser(name: str, learning_rate: float, max_iter: int) -> optax.Gr
     return optax.lbfgs()
 
 
-@eqx.filter_jit
-def _optax_step(z, opt_state, optimiser, prob, linesearch: bool):
+def _optax_step_impl(z, opt_state, optimiser, prob, linesearch: bool):
     loss_fn = lambda x: _loss(x, prob)  # noqa: E731
     if linesearch:  # L-BFGS: value and gradient kept in the state by its line search
         value, grad = optax.value_and_grad_from_state(loss_fn)(z, state=opt_state)
@@ -143,6 +146,9 @@ def _optax_step(z, opt_state, optimiser, prob, linesearch: bool):
         updates, opt_state = optimiser.update(grad, opt_state, z)
     z_new = optax.apply_updates(z, updates)
     return z_new, opt_state, value, jnp.linalg.norm(grad)
+
+
+_optax_step = jit_per_platform(_optax_step_impl)
 
 
 @dataclasses.dataclass
@@ -181,6 +187,7 @@ def run(prob: Problem, zf: Array, config: FitOptions, t_start: float) -> Trace:
 
     loss_hist, par_hist = [], []
     kept: dict = {}
+    platform = jax.default_backend()
     converged = False
     iter_marks = [time.perf_counter()]
     if config.optimiser in LSQ_OPTIMISERS:
@@ -188,10 +195,10 @@ def run(prob: Problem, zf: Array, config: FitOptions, t_start: float) -> Trace:
         prefetch(prob, zf)
         values_of(zf)  # its small program compiles now, while the evaluation program compiles in the background
         with evaluating(prob):
-            state = jax.block_until_ready(_lsq_init(zf, solver, prob))
+            state = jax.block_until_ready(_lsq_init(platform)(zf, solver, prob))
         for it in range(config.max_iter):
             with evaluating(prob, kept):
-                z_new, state, loss_acc, done, ok = jax.block_until_ready(_lsq_step(zf, state, solver, prob))
+                z_new, state, loss_acc, done, ok = jax.block_until_ready(_lsq_step(platform)(zf, state, solver, prob))
             iter_marks.append(time.perf_counter())
             zf = z_new
             keep_only(zf)
@@ -214,7 +221,7 @@ def run(prob: Problem, zf: Array, config: FitOptions, t_start: float) -> Trace:
         g0 = None
         for it in range(config.max_iter):
             with evaluating(prob, kept):
-                step = _optax_step(zf, opt_state, opt, prob, config.optimiser == "lbfgs")
+                step = _optax_step(platform)(zf, opt_state, opt, prob, config.optimiser == "lbfgs")
                 z_new, opt_state, value, gnorm = jax.block_until_ready(step)
             iter_marks.append(time.perf_counter())
             keep_only(zf)  # the step evaluated at zf (and at line-search points)
