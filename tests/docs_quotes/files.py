@@ -8,6 +8,7 @@ added) without updating the prose, or the prose was edited without a result behi
 from __future__ import annotations
 
 import json
+import statistics
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -31,6 +32,34 @@ def _runs_of(pattern: str, commit: str, n: int) -> list[dict]:
         assert d["provenance"]["commit"].startswith(commit) and not d["provenance"]["dirty"], (pattern, commit, i)
         out.append(d)
     return out
+
+
+def _lm_runs(pattern: str, commit: str, n: int) -> list[dict]:
+    """The no-noise Levenberg-Marquardt rows of an alternating A/B's ``benchmarks/bench_fit.py`` files (`_runs_of`)."""
+    return [next(r for r in d["rows"] if r["noise"] == 0.0) for d in _runs_of(pattern, commit, n)]
+
+
+def _median_range(values) -> str:
+    """Seconds as the A/B tables write them: median (min–max)."""
+    v = list(values)
+    return f"{statistics.median(v):.2f} s ({min(v):.2f}–{max(v):.2f} s)"
+
+
+def _fit_table_rows(before: list[dict], after: list[dict]) -> list[str]:
+    """The A/B table of a cold LM fit: whole fit, compilation, iterations (rows of `_lm_runs`)."""
+    rows = []
+    for label, key in (("whole fit", "fit_total_s"), ("of which compilation", "compile_s"), ("iterations", "run_s")):
+        rows.append(f"| {label} | {_median_range(r[key] for r in before)} | {_median_range(r[key] for r in after)} |")
+    return rows
+
+
+def _fit_same(rows: list[dict]) -> str:
+    """That every LM run (rows of `_lm_runs`) converged in the same number of iterations to the same error."""
+    assert all(r["converged"] for r in rows)
+    iters = {r["n_iter"] for r in rows}
+    err = {f"{r['max_rel_err_vs_true']:.1e}" for r in rows}
+    assert len(iters) == len(err) == 1
+    return f"every run took {iters.pop()} iterations to the same values ({err.pop()} off the truth)"
 
 
 def _sp(n) -> str:

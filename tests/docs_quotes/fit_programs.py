@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import statistics
 
-from .files import _runs_of
+from .files import _lm_runs, _median_range, _runs_of
 
 FE = "docs/internals/fit-engine.md"
 BEFORE, AFTER = "ea7532f", "6d479ed"
@@ -53,14 +53,11 @@ LM_NEW = "2f69375"
 
 
 def _lm(commit: str) -> list[dict]:
-    return [next(r for r in d["rows"] if r["noise"] == 0.0) for d in _ab("bench_fit_lm", commit, 5)]
+    return _lm_runs("docs/fit/programs_ab/bench_fit_lm_{commit}_{i}.json", commit, 5)
 
 
 def _lm_rows() -> tuple[str, str]:
-    cells = []
-    for c in (BEFORE, LM_NEW):
-        v = [r["fit_total_s"] for r in _lm(c)]
-        cells.append(f"{statistics.median(v):.2f} s ({min(v):.2f}–{max(v):.2f} s)")
+    cells = [_median_range(r["fit_total_s"] for r in _lm(c)) for c in (BEFORE, LM_NEW)]
     comp = [f"{statistics.median(r['compile_s'] for r in _lm(c)):.2f} s" for c in (BEFORE, LM_NEW)]
     return f"| whole fit, median (range) | {cells[0]} | {cells[1]} |", f"| of which compilation, median | {comp[0]} | {comp[1]} |"
 

@@ -7,17 +7,14 @@ from __future__ import annotations
 
 import statistics
 
-from .files import _runs_of
+from .files import _fit_same, _fit_table_rows, _lm_runs, _median_range, _runs_of
 
 PAGE = "docs/internals/compilation.md"
 BEFORE, AFTER = "2d6ecba", "376c411"
 
 
 def _lm(commit: str) -> list[dict]:
-    return [
-        next(r for r in d["rows"] if r["noise"] == 0.0)
-        for d in _runs_of("docs/fit/end_ab/bench_fit_lm_{commit}_{i}.json", commit, 5)
-    ]
+    return _lm_runs("docs/fit/end_ab/bench_fit_lm_{commit}_{i}.json", commit, 5)
 
 
 def _main(commit: str) -> list[dict]:
@@ -30,36 +27,19 @@ def _xla(d: dict, name: str) -> float | None:
     return sum(got) if got else None
 
 
-def _cell(v: list[float]) -> str:
-    return f"{statistics.median(v):.2f} s ({min(v):.2f}–{max(v):.2f} s)"
-
-
-def _fit_rows() -> list[str]:
-    rows = []
-    for label, key in (("whole fit", "fit_total_s"), ("of which compilation", "compile_s"), ("iterations", "run_s")):
-        cells = [_cell([r[key] for r in _lm(c)]) for c in (BEFORE, AFTER)]
-        rows.append(f"| {label} | {cells[0]} | {cells[1]} |")
-    return rows
-
-
-def _fit_same() -> str:
+def _fit_same_values() -> str:
     rs = _lm(BEFORE) + _lm(AFTER)
-    assert all(r["converged"] for r in rs)
-    iters = {r["n_iter"] for r in rs}
-    err = {f"{r['max_rel_err_vs_true']:.1e}" for r in rs}
-    values = {tuple(sorted(r["values"].items())) for r in rs}
-    assert len(iters) == len(err) == len(values) == 1
-    return f"every run took {iters.pop()} iterations to the same values ({err.pop()} off the truth)"
+    assert len({tuple(sorted(r["values"].items())) for r in rs}) == 1  # and the very same values
+    return _fit_same(rs)
 
 
 def _earlier_fit() -> str:
-    runs = _runs_of("docs/fit/programs_ab/bench_fit_lm_{commit}_{i}.json", "8ea00d0", 5)
-    v = [next(r for r in d["rows"] if r["noise"] == 0.0)["fit_total_s"] for d in runs]
+    v = [r["fit_total_s"] for r in _lm_runs("docs/fit/programs_ab/bench_fit_lm_{commit}_{i}.json", "8ea00d0", 5)]
     return f"the same fit took {statistics.median(v):.2f} s on 8ea00d0"
 
 
 def _main_rows() -> list[str]:
-    overhead = [_cell([d["command_compile_overhead_s"] for d in _main(c)]) for c in (BEFORE, AFTER)]
+    overhead = [_median_range(d["command_compile_overhead_s"] for d in _main(c)) for c in (BEFORE, AFTER)]
     first = [f"{statistics.median(d['runs'][0]['command_s'] for d in _main(c)):.2f} s" for c in (BEFORE, AFTER)]
     start = [f"{statistics.median(_xla(d, 'pool_start') for d in _main(c)):.2f} s" for c in (BEFORE, AFTER)]
     return [
@@ -89,8 +69,8 @@ def _warm() -> str:
 
 
 QUOTES = [
-    *[(PAGE, lambda i=i: _fit_rows()[i]) for i in range(3)],
-    (PAGE, _fit_same),
+    *[(PAGE, lambda i=i: _fit_table_rows(_lm(BEFORE), _lm(AFTER))[i]) for i in range(3)],
+    (PAGE, _fit_same_values),
     (PAGE, _earlier_fit),
     *[(PAGE, lambda i=i: _main_rows()[i]) for i in range(3)],
     (PAGE, _outputs),

@@ -7,17 +7,14 @@ from __future__ import annotations
 
 import statistics
 
-from .files import _runs_of
+from .files import _fit_same, _fit_table_rows, _lm_runs, _runs_of
 
 PAGE = "docs/internals/compilation.md"
 BEFORE, AFTER = "c2eb159", "8ea00d0"
 
 
 def _lm(commit: str) -> list[dict]:
-    return [
-        next(r for r in d["rows"] if r["noise"] == 0.0)
-        for d in _runs_of("docs/fit/programs_ab/bench_fit_lm_{commit}_{i}.json", commit, 5)
-    ]
+    return _lm_runs("docs/fit/programs_ab/bench_fit_lm_{commit}_{i}.json", commit, 5)
 
 
 def _orbit(commit: str) -> list[dict]:
@@ -29,23 +26,7 @@ def _med(values) -> float:
 
 
 def _fit_rows() -> list[str]:
-    rows = []
-    for label, key in (("whole fit", "fit_total_s"), ("of which compilation", "compile_s"), ("iterations", "run_s")):
-        cells = []
-        for c in (BEFORE, AFTER):
-            v = [r[key] for r in _lm(c)]
-            cells.append(f"{_med(v):.2f} s ({min(v):.2f}–{max(v):.2f} s)")
-        rows.append(f"| {label} | {cells[0]} | {cells[1]} |")
-    return rows
-
-
-def _fit_same() -> str:
-    rs = _lm(BEFORE) + _lm(AFTER)
-    assert all(r["converged"] for r in rs)
-    iters = {r["n_iter"] for r in rs}
-    err = {f"{r['max_rel_err_vs_true']:.1e}" for r in rs}
-    assert len(iters) == len(err) == 1
-    return f"every run took {iters.pop()} iterations to the same values ({err.pop()} off the truth)"
+    return _fit_table_rows(_lm(BEFORE), _lm(AFTER))
 
 
 def _program(d: dict, name: str) -> float:
@@ -78,7 +59,7 @@ def _orbit_same() -> str:
 
 QUOTES = [
     *[(PAGE, lambda i=i: _fit_rows()[i]) for i in range(3)],
-    (PAGE, _fit_same),
+    (PAGE, lambda: _fit_same(_lm(BEFORE) + _lm(AFTER))),
     *[(PAGE, lambda i=i: _orbit_rows()[i]) for i in range(6)],
     (PAGE, _orbit_same),
 ]
