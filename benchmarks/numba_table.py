@@ -24,6 +24,10 @@ prints a table with the ratios, versions and CPU.
 
     python benchmarks/numba_table.py --out docs/performance/numba_table_400x300.json
     python benchmarks/numba_table.py --n-freq 40 --periods 40 --sample 10 --reps 1 --out /tmp/t.json   # smoke
+    python benchmarks/numba_table.py --modes on --engines jaxcelt --out /tmp/on.json   # one row, jaxcelt only
+
+With ``--modes`` or ``--engines`` narrowed, only those rows run: the ratios need both engines, and the scipy row
+needs jaxcelt stopping at invalid states (its per-lane step counts), so they are left out otherwise.
 """
 
 from __future__ import annotations
@@ -138,6 +142,8 @@ def main() -> int:
     ap.add_argument("--reps", type=int, default=3)
     ap.add_argument("--scipy-subset", type=int, default=8)
     ap.add_argument("--out", type=Path, default=Path("docs/performance/numba_table_400x300.json"))
+    ap.add_argument("--modes", default="stop,on", help="comma-separated, of stop,on (default both)")
+    ap.add_argument("--engines", default="jaxcelt,numba", help="comma-separated, of jaxcelt,numba (default both)")
     ap.add_argument("--child", default=None, help=argparse.SUPPRESS)
     a = ap.parse_args()
     if a.child:
@@ -145,6 +151,10 @@ def main() -> int:
         return 0
     if not (0 < a.sample <= a.periods) or a.n_freq < 1 or a.reps < 1:
         print("numba_table: need 0 < --sample <= --periods, --n-freq >= 1, --reps >= 1", file=sys.stderr)
+        return 2
+    modes, engines = a.modes.split(","), a.engines.split(",")
+    if not modes or set(modes) - {"stop", "on"} or not engines or set(engines) - {"jaxcelt", "numba"}:
+        print("numba_table: --modes takes stop and/or on, --engines jaxcelt and/or numba", file=sys.stderr)
         return 2
     from jaxcelt.provenance import load_average, machine, write_result
     from jaxcelt.versions import versions
@@ -155,9 +165,9 @@ def main() -> int:
     res = {"config": vars(a) | {"out": str(a.out), "rtol": 1e-8, "atol": 1e-10, "max_steps": 10**6},
            "versions": versions(), "machine": machine(), "jaxcelt_cpu_devices": os.cpu_count() or 1,
            "numba_threads": os.cpu_count() or 1, "modes": {}}  # fmt: skip
-    for mode in ("stop", "on"):
+    for mode in [m for m in ("stop", "on") if m in modes]:
         row = {}
-        for engine in ("jaxcelt", "numba"):
+        for engine in [e for e in ("jaxcelt", "numba") if e in engines]:
             numba_cache = tempfile.mkdtemp(prefix="jaxcelt-numba-cache-")  # empty: numba compiles in the first call
             env = dict(os.environ, JAXCELT_CACHE_DIR="off", NUMBA_CACHE_DIR=numba_cache)
             env.pop("JAX_COMPILATION_CACHE_DIR", None)
@@ -168,16 +178,25 @@ def main() -> int:
                 return 1
             row[engine] = json.loads(out.stdout.strip().splitlines()[-1]) | {"process_s": time.perf_counter() - t}
             print(mode, engine, {k: v for k, v in row[engine].items() if k != "steps_per_lane"}, flush=True)
-        j, n = row["jaxcelt"], row["numba"]
-        row["warm_speedup_vs_numba"] = n["warm_s"] / j["warm_s"]
-        row["first_call_speedup_vs_numba"] = n["first_call_s"] / j["first_call_s"]
-        row["first_call_minus_warm_jaxcelt_s"] = j["first_call_s"] - j["warm_s"]
+        if "jaxcelt" in row:
+            row["first_call_minus_warm_jaxcelt_s"] = row["jaxcelt"]["first_call_s"] - row["jaxcelt"]["warm_s"]
+        if "jaxcelt" in row and "numba" in row:
+            j, n = row["jaxcelt"], row["numba"]
+            row["warm_speedup_vs_numba"] = n["warm_s"] / j["warm_s"]
+            row["first_call_speedup_vs_numba"] = n["first_call_s"] / j["first_call_s"]
         res["modes"][mode] = row
-    res["scipy_stop"] = _scipy(a, np.asarray(res["modes"]["stop"]["jaxcelt"]["steps_per_lane"], float))
-    print("scipy (stop at invalid)", res["scipy_stop"], flush=True)
+    if "jaxcelt" in res["modes"].get("stop", {}):
+        res["scipy_stop"] = _scipy(a, np.asarray(res["modes"]["stop"]["jaxcelt"]["steps_per_lane"], float))
+        print("scipy (stop at invalid)", res["scipy_stop"], flush=True)
     print(f"\n{'mode':<18}{'numba warm':>12}{'jaxcelt warm':>14}{'ratio':>8}{'jaxcelt 1st':>13}{'numba 1st':>11}"
           f"{'steps jax/numba':>22}  statuses jax / numba")  # fmt: skip
     for mode, row in res["modes"].items():
+        if "numba" not in row or "jaxcelt" not in row:
+            for engine, r in row.items():
+                if isinstance(r, dict):
+                    print(f"{mode:<18}{engine}: warm {r['warm_s']:.1f} s, first call {r['first_call_s']:.1f} s, "
+                          f"{r['lane_steps'] / 1e6:.1f}M lane-steps, {r['status_counts']}")  # fmt: skip
+            continue
         j, n = row["jaxcelt"], row["numba"]
         print(f"{mode:<18}{n['warm_s']:>11.1f}s{j['warm_s']:>13.1f}s{row['warm_speedup_vs_numba']:>7.2f}x"
               f"{j['first_call_s']:>12.1f}s{n['first_call_s']:>10.1f}s"
