@@ -288,6 +288,36 @@ def test_pool_drain_compaction_keeps_lanes(paper_params):
         run_lanes(pb, y0, cfg, width=32, devices=one, drain_min_steps=-1)
 
 
+def test_drain_compiles_early_integrating_on_and_runs_only_when_needed(paper_params, monkeypatch):
+    # Integrating every lane on, the drain's program is sent to compile with the pool's others (lanes that stick
+    # to the base are long); stopping at invalid states, only when the lanes left need it. Whether it runs depends
+    # on the lanes alone: these lanes' last few hundred steps are below DRAIN_MIN_STEPS, so the pool finishes at
+    # its full width (every iteration paid 32 slots), with the same lanes as a pool that does drain
+    # (drain_min_steps=0). Same step counts and statuses, samples within SAMPLE_ATOL (another width is another
+    # compiled program; see test_pool_drain_compaction_keeps_lanes).
+    from jaxcelt.ensemble import SweepConfig, lane_programs, run_lanes
+
+    sent = []
+    real = lane_programs.compile_later
+    monkeypatch.setattr(lane_programs, "compile_later", lambda fn: sent.append(getattr(fn, "__name__", "")) or real(fn))
+    vals = np.linspace(12.0, 19.0, 40)
+    y0 = np.tile(np.asarray(jc.initial_state(paper_params)), (len(vals), 1))
+    pb = lanes_params(paper_params, "omega_pi", vals)
+    one = jax.local_devices()[:1]
+    on = SweepConfig(transient_periods=0, sample_periods=2, max_steps=4000, stop_on_invalid=False)
+    full = run_lanes(pb, y0, on, width=32, devices=one)
+    assert sent.count("drain_program") == 1  # sent with the others, not run
+    it, paid = int(full["pool_iterations"][0]), int(full["pool_slot_steps"][0])
+    assert paid == 32 * it
+    drained = run_lanes(pb, y0, on, width=32, devices=one, drain_min_steps=0)
+    it, paid = int(drained["pool_iterations"][0]), int(drained["pool_slot_steps"][0])
+    assert paid < 32 * it
+    assert_same_lanes(full, drained)
+    sent.clear()
+    run_lanes(pb, y0, dataclasses.replace(on, stop_on_invalid=True), width=32, devices=one)
+    assert "drain_program" not in sent
+
+
 def test_wide_vector_pool_keeps_lanes(paper_params):
     # A pool of >= WIDE_VECTORS_MIN_SLOTS slots per device is compiled for 512-bit vectors on a CPU
     # (`jaxcelt._compile_options.pool_compiler_options`), a narrower one with XLA's defaults: two

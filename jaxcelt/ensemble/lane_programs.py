@@ -174,9 +174,11 @@ def prepare_pool(
     iterations and step slots paid per device).
 
     Three programs compile at the same time (`pool_start`, `pool_advance` at ``width``, `pool_outputs`); the drain's
-    narrower widths (`drain_widths` with ``drain`` = (factor, minimum width)) are a fourth, compiled and run only
-    when a lane left at the end of the full-width phase is predicted to need at least ``drain_min_steps`` more steps
-    (`remaining_steps`), or with ``compile_only`` compiled and not run."""
+    narrower widths (`drain_widths` with ``drain`` = (factor, minimum width)) are a fourth, run only when a lane left
+    at the end of the full-width phase is predicted to need at least ``drain_min_steps`` more steps
+    (`remaining_steps`). It is compiled then, when lanes stop at invalid states; with the others, when every lane is
+    integrated on (``cfg.stop_on_invalid`` false: lanes that stick to the base are long) or with ``compile_only``
+    (compiled and not run). Which programs run depends on the lanes alone, not on when they were compiled."""
     widths = drain_widths(width, lanes_per_device, *drain)
     adv_kw = dict(cfg=cfg, mesh=mesh, vary=vary)
     pause, no_until = jnp.asarray(pause_frac), jnp.asarray(0, jnp.int32)
@@ -197,8 +199,14 @@ def prepare_pool(
                                          narrow_to=tuple(widths[1:]), **adv_kw)  # fmt: skip
         return lowered.compile(pool_compiler_options(platform, widths[-1]))
 
+    # Integrating every lane on, the lanes that stick to the base run long enough for the drain: its program is
+    # sent to compile now, after the three above, so that it compiles while the full-width program compiles and
+    # runs instead of after it. Stopping at invalid states, it compiles only when the lanes left need it.
+    early_drain = len(widths) > 1 and (compile_only or not cfg.stop_on_invalid)
+    drain_early = compile_later(drain_program) if early_drain else None
+
     def run():
-        drain_compiled = compile_later(drain_program) if compile_only and len(widths) > 1 else None
+        drain_compiled = drain_early
         carry = start_compiled.result()(pb, y0b, live, transient, tols)
         wide = wide_compiled.result()
         until = jnp.asarray(widths[1] if len(widths) > 1 else 0, jnp.int32)
@@ -214,7 +222,7 @@ def prepare_pool(
             else:
                 carry = wide(pb, carry, pause, transient, no_until, opaque_true)
         out = out_compiled.result()(pb, carry.lanes, carry.samples, transient)
-        if drain_compiled is not None:  # compile_only: every program compiled before returning
+        if compile_only and drain_compiled is not None:  # every program compiled before returning
             drain_compiled.result()
         return out, carry.iters, carry.slot_steps
 

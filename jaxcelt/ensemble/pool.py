@@ -81,8 +81,10 @@ another compiled step, which costs about as much compilation as the full-width o
 DRAIN_MIN_STEPS = 100_000
 """`jaxcelt.ensemble.run_lanes` runs the drain's narrower widths, a program of their own, only
 when a lane left at the end of the full-width phase is predicted to need at least this many more
-steps (`remaining_steps`); otherwise the last lanes finish at the full width, and the drain is
-not compiled. Compiling it costs seconds; a full-width iteration costs tens of microseconds more
+steps (`remaining_steps`); otherwise the last lanes finish at the full width. Stopping at invalid
+states, the drain is then not compiled either; integrating every lane on, where lanes that stick to
+the base are long, it compiles beside the pool's other programs from the start
+(`jaxcelt.ensemble.lane_programs.prepare_pool`). Compiling it costs seconds; a full-width iteration costs tens of microseconds more
 than a narrow one, so the drain pays for lanes of ~10^5 steps: lanes that stick to the base when
 lanes are integrated on (``benchmarks/max_steps_study.py``), not the lanes of a sweep that stops
 at invalid states. The decision depends on the lanes alone, so a call gives the same results
