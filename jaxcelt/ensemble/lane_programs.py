@@ -10,6 +10,7 @@ times and the per-lane extras.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from collections.abc import Callable
 from typing import Any
@@ -18,7 +19,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxcelt._compile_options import compiler_options, pool_compiler_options
+from jaxcelt._compile_options import compiler_options, is_wide_pool, pool_compiler_options
 from jaxcelt._executable_cache import compile_later, gc_paused
 from jaxcelt._types import Array
 from jaxcelt.ensemble.config import SweepConfig
@@ -38,6 +39,7 @@ from jaxcelt.ensemble.pool import (
 )
 from jaxcelt.ensemble.shard import LANE_AXIS, shard_lanes
 from jaxcelt.ensemble.stepper import AbstractLaneStepper, FusedERKStepper, float64_times, make_stepper
+from jaxcelt.physics.contact.registry import get_contact_law
 from jaxcelt.physics.diagnostics import centre_position
 from jaxcelt.physics.params import CeltParams
 
@@ -143,6 +145,15 @@ def pool_outputs(
     return shard_lanes(run, mesh, 3)(pb, lanes, samples)
 
 
+def pool_config(cfg: SweepConfig, platform: str, slots: int) -> SweepConfig:
+    """``cfg`` with the contact law's form for a pool of ``slots`` slots per device on ``platform``: its
+    ``wide_batch`` form (the vectorised logarithm) where the pool gets wide vectors (`jaxcelt._compile_options.is_wide_pool`),
+    as given otherwise."""
+    if is_wide_pool(platform, slots):
+        return dataclasses.replace(cfg, contact_law=get_contact_law(cfg.contact_law).wide_batch())
+    return cfg
+
+
 def _abstract(tree: Any, mesh: Any) -> Any:
     """``tree``'s shapes (e.g. a lowered program's ``out_info``) with the lane-axis sharding of ``mesh``: a program taking
     it is compiled for the arrays the pool's programs hand on."""
@@ -178,8 +189,12 @@ def prepare_pool(
     at the end of the full-width phase is predicted to need at least ``drain_min_steps`` more steps
     (`remaining_steps`). It is compiled then, when lanes stop at invalid states; with the others, when every lane is
     integrated on (``cfg.stop_on_invalid`` false: lanes that stick to the base are long) or with ``compile_only``
-    (compiled and not run). Which programs run depends on the lanes alone, not on when they were compiled."""
+    (compiled and not run). Which programs run depends on the lanes alone, not on when they were compiled. Each
+    program gets the contact law's form and compiler options of its width (`pool_config`,
+    `jaxcelt._compile_options.pool_compiler_options`; the drain's: of its last width)."""
     widths = drain_widths(width, lanes_per_device, *drain)
+    drain_cfg = pool_config(cfg, platform, widths[-1])  # the drain's program: the law's form of its last width
+    cfg = pool_config(cfg, platform, width)
     adv_kw = dict(cfg=cfg, mesh=mesh, vary=vary)
     pause, no_until = jnp.asarray(pause_frac), jnp.asarray(0, jnp.int32)
     with gc_paused():
@@ -196,7 +211,7 @@ def prepare_pool(
     def drain_program():
         with gc_paused():
             lowered = pool_advance.lower(pb, carry_spec, pause, transient, no_until, opaque_true,
-                                         narrow_to=tuple(widths[1:]), **adv_kw)  # fmt: skip
+                                         narrow_to=tuple(widths[1:]), **(adv_kw | dict(cfg=drain_cfg)))  # fmt: skip
         return lowered.compile(pool_compiler_options(platform, widths[-1]))
 
     # Integrating every lane on, the lanes that stick to the base run long enough for the drain: its program is

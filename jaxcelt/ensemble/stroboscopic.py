@@ -24,7 +24,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxcelt import _config  # noqa: F401
-from jaxcelt._compile_options import is_wide_pool, jit_per_platform
+from jaxcelt._compile_options import jit_per_platform
 from jaxcelt._executable_cache import compile_later, gc_paused, start_deferred
 from jaxcelt._types import Array
 from jaxcelt.ensemble.config import ENGINES, SweepConfig, check_engine
@@ -43,7 +43,6 @@ from jaxcelt.ensemble.runners import AbstractLaneRunner
 from jaxcelt.ensemble.shard import device_mesh, pad_lanes, shard_lanes
 from jaxcelt.ensemble.stepper import float64_times
 from jaxcelt.integrate.lyapunov import celt_lyapunov
-from jaxcelt.physics.contact.registry import get_contact_law
 from jaxcelt.physics.params import PARAM_NAMES, CeltParams
 
 __all__ = ["SweepConfig", "lanes_params", "run_lanes", "run_lanes_with_stats", "ENGINES", "check_engine"]
@@ -275,8 +274,6 @@ def _run_lanes(
     # kernel boundaries pay on CPU (`jaxcelt.ensemble.kernel_boundary`); on an accelerator a
     # conditional costs a device-to-host sync per stage, so none there
     opaque_true = jnp.asarray(True) if platform == "cpu" else None
-    if is_wide_pool(platform, Wd):  # the contact law's form for wide batches (vectorised logarithm)
-        nocfg = dataclasses.replace(nocfg, contact_law=get_contact_law(nocfg.contact_law).wide_batch())
     G = Wd * ndev  # the Lyapunov stage's chunk: the pool's width (a chunk of few lanes solves no padding copies)
     lyap_fn = _lyap_chunk(platform)
     # The pool's programs and the Lyapunov stage's are traced here, one after the other, and
