@@ -8,7 +8,9 @@ Each entry is (document, function returning the quoted text).
 
 from __future__ import annotations
 
-from .files import _json, _sp
+import statistics
+
+from .files import _json, _median_range, _runs_of, _sp
 
 PAGE = "docs/internals/sweep-engine.md"
 AFTER = "docs/performance/numba_table_400x300.json"
@@ -138,3 +140,66 @@ def rerun2_host() -> str:
 
 
 QUOTES += [(PAGE, rerun), (PAGE, stage_loop), (PAGE, lambda: rerun(RERUN2)), (PAGE, rerun2_host)]
+
+
+RERUN3 = "docs/performance/numba_table_400x300_rerun3.json"
+DRAIN_AB = "docs/performance/drain_ab/numba_on_{commit}_{i}.json"
+DRAIN_COMMITS = ("c22b69e", "264599e", "b8f0b6b")  # before; drain compiled from the start; its width's law form
+
+
+def _drain_rows(commit: str) -> list[dict]:
+    return [d["modes"]["on"]["jaxcelt"] for d in _runs_of(DRAIN_AB, commit, 4)]
+
+
+def drain_ab() -> str:
+    """The drain A/B (integrating on, jaxcelt only, three commits in turn), in words."""
+    rows = [_drain_rows(c) for c in DRAIN_COMMITS]
+    above = [_median_range(r["first_call_s"] - r["warm_s"] for r in rs) for rs in rows]
+    first = [_median_range(r["first_call_s"] for r in rs) for rs in rows]
+    warm = [_median_range(r["warm_s"] for r in rs) for rs in rows]
+    steps = [sorted({r["lane_steps"] for r in rs}) for rs in rows]
+    assert all(len(s) == 1 for s in steps), steps  # every process of a commit took the same steps
+    assert all(sorted(r["status_counts"].items()) == sorted(rows[0][0]["status_counts"].items()) for rs in rows for r in rs)
+    return (
+        f"A first call {above[0]} above a warm one before, {above[1]} with the drain compiled from the start, "
+        f"{above[2]} with its width's form of the law; first calls {first[0]}, {first[1]} and {first[2]}; warm calls "
+        f"{warm[0]}, {warm[1]} and {warm[2]}. The same statuses in every process; lane-steps {_sp(steps[0][0])}, "
+        f"{_sp(steps[1][0])} and {_sp(steps[2][0])}"
+    )
+
+
+def rerun3_compile() -> str:
+    """What the final table's first calls logged for the pool's stepping programs."""
+    m = _json(RERUN3)["modes"]
+    adv = {k: [round(t, 1) for n, t in m[k]["jaxcelt"]["first_call_compile_log"] if n == "XLA compilation of jit(pool_advance)"] for k in m}
+    return (
+        f"XLA compiled `pool_advance` in {adv['stop'][0]:.1f} s stopping; integrating on, the full-width program and the "
+        f"drain at the same time, in {adv['on'][0]:.1f} s and {adv['on'][1]:.1f} s (in the order they finished)"
+    )
+
+
+QUOTES += [(PAGE, drain_ab), (PAGE, lambda: rerun(RERUN3)), (PAGE, rerun3_compile)]
+
+
+def perf_latest() -> str:
+    """The final table on the performance page, in words."""
+    m = _json(RERUN3)["modes"]
+    s, o = m["stop"], m["on"]
+    return (
+        f"stopping, warm {s['jaxcelt']['warm_s']:.1f} s against numba's {s['numba']['warm_s']:.1f} s, a first call "
+        f"{s['jaxcelt']['first_call_s']:.1f} s against {s['numba']['first_call_s']:.1f} s; integrating on, warm "
+        f"{o['jaxcelt']['warm_s']:.1f} s against {o['numba']['warm_s']:.1f} s, a first call {o['jaxcelt']['first_call_s']:.1f} s "
+        f"against {o['numba']['first_call_s']:.1f} s"
+    )
+
+
+QUOTES += [("docs/performance.md", perf_latest)]
+
+
+def changelog_drain() -> str:
+    """The drain A/B's medians as the changelog gives them."""
+    med = [statistics.median(r["first_call_s"] - r["warm_s"] for r in _drain_rows(c)) for c in DRAIN_COMMITS]
+    return f"{med[0]:.2f} s -> {med[2]:.2f} s above a warm one"
+
+
+QUOTES += [("CHANGELOG.md", changelog_drain)]
