@@ -329,9 +329,9 @@ QUOTES = [
     ],
     ("docs/performance.md", lambda: "| 2 threads | {:.1f} |".format(_bench()["numba_dp5_ensemble_stop_on_invalid"]["seconds"])),
     ("docs/performance.md", lambda: "| 1 | {:.1f} | — |".format(_bench()["scipy_dop853_numba_rhs_stop_on_invalid"]["seconds"])),
-    ("docs/performance.md", lambda: "with its compilation the pool takes {:.1f} s against the numba ensemble's {:.1f} s".format(
+    ("docs/performance.md", lambda: "with its compilation the pool took {:.1f} s against the numba ensemble's {:.1f} s".format(
         _bench()["summary"]["total_with_compile_s"], _bench()["numba_dp5_ensemble_stop_on_invalid"]["seconds"])),
-    ("docs/performance.md", lambda: "the pool takes {:.1f} s warm and {:.1f} s with compilation, against numba's {:.1f} s".format(
+    ("docs/performance.md", lambda: "the pool took {:.1f} s warm and {:.1f} s with compilation, against numba's {:.1f} s".format(
         _bench()["jaxcelt_pool"]["seconds"], _bench()["jaxcelt_pool"]["seconds"] + _bench()["jaxcelt_pool"]["compile_seconds"],
         _bench()["numba_dp5_ensemble"]["seconds"])),
     ("docs/performance.md", lambda: "2 cores is {:.1f}× faster in wall time, **{:.1f}× per core** (Tsit5; Dopri8,".format(
