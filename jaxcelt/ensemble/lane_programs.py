@@ -217,11 +217,11 @@ def prepare_pool(
     # Integrating every lane on, the lanes that stick to the base run long enough for the drain: its program is
     # sent to compile now, after the three above, so that it compiles while the full-width program compiles and
     # runs instead of after it. Stopping at invalid states, it compiles only when the lanes left need it.
-    early_drain = len(widths) > 1 and (compile_only or not cfg.stop_on_invalid)
-    drain_early = compile_later(drain_program) if early_drain else None
+    early = len(widths) > 1 and (compile_only or not cfg.stop_on_invalid)
+    drain_sent = compile_later(drain_program) if early else None
 
     def run():
-        drain_compiled = drain_early
+        drain_compiled = drain_sent
         carry = start_compiled.result()(pb, y0b, live, transient, tols)
         wide = wide_compiled.result()
         until = jnp.asarray(widths[1] if len(widths) > 1 else 0, jnp.int32)

@@ -169,7 +169,7 @@ class _Evaluation:
         zf = np.asarray(zf, np.float64)
         r, J = evaluate(self.problem, zf)
         if self.kept is not None and zf.ndim == 1:
-            self.kept[zf.tobytes()] = (r, J)
+            self.kept[kept_key(zf)] = (r, J)
         return r, J
 
 
