@@ -41,19 +41,25 @@ def test_sincos_nan_and_float32():
     np.testing.assert_allclose(np.asarray(s32), np.sin(0.5), rtol=1e-6)
 
 
-def test_log_within_1_ulp_of_numpy():
+@pytest.mark.parametrize("normal", [False, True])
+def test_log_within_1_ulp_of_numpy(normal):
     # tolerance: 1 ulp of the result (fdlibm documents its log at < 1 ulp; libm is correctly
     # rounded to < 1 ulp); arguments over the whole normal range and densely near 1, where
-    # log x is small and the mantissa reduction matters most
+    # log x is small and the mantissa reduction matters most. ``normal=True`` (no special-value
+    # handling) must give the same values on positive normal arguments.
     rng = np.random.default_rng(0)
     x = np.concatenate([
         np.exp(rng.uniform(-708.0, 709.0, 200_000)), rng.uniform(0.5, 2.0, 200_000),
         [2.2250738585072014e-308, np.nextafter(1.0, 0.0), np.nextafter(1.0, 2.0), 1.7976931348623157e308],
     ])  # fmt: skip
-    got, ref = np.asarray(jax.jit(log)(x)), np.log(x)
+    got, ref = np.asarray(jax.jit(lambda x: log(x, normal=normal))(x)), np.log(x)
     err = np.abs(got - ref)
     assert np.max(err / np.spacing(np.abs(ref))) <= 1.0
-    assert np.asarray(log(1.0)) == 0.0
+    assert np.asarray(log(1.0, normal=normal)) == 0.0
+    # derivative 1/x (custom JVP), to rounding of one division
+    xs = jnp.linspace(0.1, 50.0, 41)
+    d = jax.vmap(jax.grad(lambda x: log(x, normal=normal)))(xs)
+    np.testing.assert_allclose(np.asarray(d), 1 / np.asarray(xs), rtol=1e-15)
 
 
 def test_log_special_values_and_gradient():
