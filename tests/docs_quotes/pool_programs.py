@@ -183,7 +183,7 @@ QUOTES += [(PAGE, drain_ab), (PAGE, lambda: rerun(RERUN3)), (PAGE, rerun3_compil
 
 def perf_latest() -> str:
     """The final table on the performance page, in words."""
-    m = _json(RERUN3)["modes"]
+    m = _json(RERUN4)["modes"]
     s, o = m["stop"], m["on"]
     return (
         f"stopping, warm {s['jaxcelt']['warm_s']:.1f} s against numba's {s['numba']['warm_s']:.1f} s, a first call "
@@ -203,3 +203,56 @@ def changelog_drain() -> str:
 
 
 QUOTES += [("CHANGELOG.md", changelog_drain)]
+
+
+FIELD_COMMITS = ("1adaa3d", "5c549db")  # before; the field with fewer divisions (4aa02e0, benchmark script 5c549db)
+FIELD_AB = "docs/performance/field_ab/numba_stop_{commit}_{i}.json"
+POOL_OPS = "docs/performance/field_ab/pool_ops_{commit}.json"
+RERUN4 = "docs/performance/numba_table_400x300_rerun4.json"
+
+
+def _field_rows(commit: str) -> list[dict]:
+    return [d["modes"]["stop"]["jaxcelt"] for d in _runs_of(FIELD_AB, commit, 3)]
+
+
+def field_ab() -> str:
+    """The field A/B (stopping, jaxcelt only, the two commits in turn), in words."""
+    rows = [_field_rows(c) for c in FIELD_COMMITS]
+    warm = [_median_range(r["warm_s"] for r in rs) for rs in rows]
+    first = [_median_range(r["first_call_s"] for r in rs) for rs in rows]
+    ratio = statistics.median(r["warm_s"] for r in rows[0]) / statistics.median(r["warm_s"] for r in rows[1])
+    steps = [sorted({r["lane_steps"] for r in rs}) for rs in rows]
+    assert all(len(s) == 1 for s in steps), steps  # every process of a commit took the same steps
+    status = [sorted({tuple(sorted(r["status_counts"].items())) for r in rs}) for rs in rows]
+    assert all(len(s) == 1 for s in status), status
+    return (
+        f"warm calls {warm[1]} against {warm[0]} ({ratio:.2f}×), first calls {first[1]} against {first[0]}; "
+        f"lane-steps {_sp(steps[1][0])} against {_sp(steps[0][0])}, statuses "
+        f"{', '.join(f'{v} × {k}' for k, v in status[1][0])} against {', '.join(f'{v} × {k}' for k, v in status[0][0])}"
+    )
+
+
+def field_ops() -> str:
+    """Operations per lane in the optimised `pool_advance` of the two commits."""
+    before, after = (_json(POOL_OPS.format(commit=c)) for c in FIELD_COMMITS)
+    for d, c in zip((before, after), FIELD_COMMITS):
+        assert d["provenance"]["commit"].startswith(c) and not d["provenance"]["dirty"], c
+    o, n = before["programs"][0]["ops_per_lane"], after["programs"][0]["ops_per_lane"]
+    f = lambda k: f"{_sp(round(o[k]))} → {_sp(round(n[k]))}"  # noqa: E731
+    roots = lambda d: _sp(round(d["sqrt"] + d["rsqrt"]))  # noqa: E731
+    return (
+        f"divisions {f('divide')}, square roots {roots(o)} → {roots(n)}, exponentials {f('exponential')}, "
+        f"multiplications {f('multiply')}, selects {f('select')}"
+    )
+
+
+QUOTES += [(PAGE, field_ab), (PAGE, field_ops), (PAGE, lambda: rerun(RERUN4))]
+
+
+def rerun4_statuses() -> str:
+    """Integrating on, the statuses of the last two tables."""
+    a, b = (_json(p)["modes"]["on"]["jaxcelt"]["status_counts"] for p in (RERUN4, RERUN3))
+    return f"{a['0']} lanes end their run, {a['4']} past validity ({b['0']} and {b['4']} at b8f0b6b)"
+
+
+QUOTES += [(PAGE, rerun4_statuses)]
