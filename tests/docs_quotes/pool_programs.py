@@ -183,7 +183,7 @@ QUOTES += [(PAGE, drain_ab), (PAGE, lambda: rerun(RERUN3)), (PAGE, rerun3_compil
 
 def perf_latest() -> str:
     """The final table on the performance page, in words."""
-    m = _json(RERUN4)["modes"]
+    m = _json(RERUN5)["modes"]
     s, o = m["stop"], m["on"]
     return (
         f"stopping, warm {s['jaxcelt']['warm_s']:.1f} s against numba's {s['numba']['warm_s']:.1f} s, a first call "
@@ -215,9 +215,9 @@ def _field_rows(commit: str) -> list[dict]:
     return [d["modes"]["stop"]["jaxcelt"] for d in _runs_of(FIELD_AB, commit, 3)]
 
 
-def field_ab() -> str:
-    """The field A/B (stopping, jaxcelt only, the two commits in turn), in words."""
-    rows = [_field_rows(c) for c in FIELD_COMMITS]
+def field_ab(commits: tuple[str, str] = FIELD_COMMITS) -> str:
+    """A field A/B (stopping, jaxcelt only, the two commits in turn), in words."""
+    rows = [_field_rows(c) for c in commits]
     warm = [_median_range(r["warm_s"] for r in rs) for rs in rows]
     first = [_median_range(r["first_call_s"] for r in rs) for rs in rows]
     ratio = statistics.median(r["warm_s"] for r in rows[0]) / statistics.median(r["warm_s"] for r in rows[1])
@@ -232,10 +232,10 @@ def field_ab() -> str:
     )
 
 
-def field_ops() -> str:
+def field_ops(commits: tuple[str, str] = FIELD_COMMITS) -> str:
     """Operations per lane in the optimised `pool_advance` of the two commits."""
-    before, after = (_json(POOL_OPS.format(commit=c)) for c in FIELD_COMMITS)
-    for d, c in zip((before, after), FIELD_COMMITS):
+    before, after = (_json(POOL_OPS.format(commit=c)) for c in commits)
+    for d, c in zip((before, after), commits):
         assert d["provenance"]["commit"].startswith(c) and not d["provenance"]["dirty"], c
     o, n = before["programs"][0]["ops_per_lane"], after["programs"][0]["ops_per_lane"]
     f = lambda k: f"{_sp(round(o[k]))} → {_sp(round(n[k]))}"  # noqa: E731
@@ -256,3 +256,18 @@ def rerun4_statuses() -> str:
 
 
 QUOTES += [(PAGE, rerun4_statuses)]
+
+
+LOG_COMMITS = ("2791e40", "135b478")  # before (the code of 5c549db); the Pade denominators with one logarithm fewer
+RERUN5 = "docs/performance/numba_table_400x300_rerun5.json"
+QUOTES += [(PAGE, lambda: field_ab(LOG_COMMITS)), (PAGE, lambda: field_ops(("5c549db", "135b478"))), (PAGE, lambda: rerun(RERUN5))]
+
+
+def main_job_compile_ab() -> str:
+    """The main job's compile overhead (whole command) at the three commits, two fresh processes each."""
+    pat = "docs/performance/field_ab/main_job_compile_{commit}_{i}.json"
+    runs = [[d["command_compile_overhead_s"] for d in _runs_of(pat, c, 2)] for c in ("1adaa3d", "5c549db", "135b478")]
+    return ", ".join(" and ".join(f"{x:.1f} s" for x in r) for r in runs)
+
+
+QUOTES += [(PAGE, main_job_compile_ab)]
