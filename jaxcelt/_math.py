@@ -75,19 +75,23 @@ def _horner(z: Array, coeffs: tuple[float, ...]) -> Array:
 
 def _sincos_f64(x: Array) -> tuple[Array, Array]:
     ax = jnp.abs(x)
-    y = jnp.floor(ax * (4 / np.pi))  # octant
-    y = y + jnp.mod(y, 2.0)  # round odd octants up: z in [-pi/4, pi/4]
+    y = jnp.floor(ax * (4 / np.pi))  # octant (inf and NaN stay so: z is NaN, so are sine and cosine)
+    j = y.astype(jnp.int64)
+    odd = j & 1
+    j = j + odd  # round odd octants up: z in [-pi/4, pi/4]
+    y = y + odd.astype(x.dtype)
     z = ((ax - y * _DP1) - y * _DP2) - y * _DP3
     zz = z * z
     ps = z + z * zz * _horner(zz, _SIN)
     pc = 1.0 - 0.5 * zz + zz * zz * _horner(zz, _COS)
-    q = jnp.mod(y, 8.0)  # 0, 2, 4, 6: quadrant 0..3
-    swap = (q == 2.0) | (q == 6.0)
+    # j mod 8 in {0, 2, 4, 6} (quadrant 0..3), read from its bits: 2 swaps sine and cosine, 4 negates
+    # the sine, and the cosine is negative in quadrants 1 and 2 (bit 4 of j + 2)
+    swap = (j & 2) != 0
     s = jnp.where(swap, pc, ps)
     c = jnp.where(swap, ps, pc)
-    s = jnp.where(q >= 4.0, -s, s)
-    c = jnp.where((q == 2.0) | (q == 4.0), -c, c)
-    return jnp.where(x < 0, -s, s), c
+    s = jnp.where(((j & 4) != 0) != (x < 0), -s, s)
+    c = jnp.where(((j + 2) & 4) != 0, -c, c)
+    return s, c
 
 
 @jax.custom_jvp
