@@ -271,3 +271,7 @@ def main_job_compile_ab() -> str:
 
 
 QUOTES += [(PAGE, main_job_compile_ab)]
+
+
+QUADRANT_COMMITS = ("ecdf62f", "f109721")  # before (the code of 135b478); sincos's quadrant from integer bits
+QUOTES += [(PAGE, lambda: field_ab(QUADRANT_COMMITS)), (PAGE, lambda: field_ops(("135b478", "f109721")))]
