@@ -151,20 +151,32 @@ def _drain_rows(commit: str) -> list[dict]:
     return [d["modes"]["on"]["jaxcelt"] for d in _runs_of(DRAIN_AB, commit, 4)]
 
 
+def _ab_per_commit(rows: list[list[dict]]) -> dict[str, list]:
+    """An A/B's jaxcelt rows (one list per commit) summarised per commit: median (range) of the warm and first calls
+    and of the first call above the warm one; the lane-steps and statuses, each checked to be one per commit (every
+    process of a commit ran the same program on the same lanes)."""
+    steps = [{r["lane_steps"] for r in rs} for rs in rows]
+    status = [{tuple(sorted(r["status_counts"].items())) for r in rs} for rs in rows]
+    assert all(len(x) == 1 for x in steps + status), (steps, status)
+    return {
+        "warm": [_median_range(r["warm_s"] for r in rs) for rs in rows],
+        "first": [_median_range(r["first_call_s"] for r in rs) for rs in rows],
+        "above": [_median_range(r["first_call_s"] - r["warm_s"] for r in rs) for rs in rows],
+        "steps": [_sp(x.pop()) for x in steps],
+        "status": [dict(x.pop()) for x in status],
+    }
+
+
 def drain_ab() -> str:
     """The drain A/B (integrating on, jaxcelt only, three commits in turn), in words."""
-    rows = [_drain_rows(c) for c in DRAIN_COMMITS]
-    above = [_median_range(r["first_call_s"] - r["warm_s"] for r in rs) for rs in rows]
-    first = [_median_range(r["first_call_s"] for r in rs) for rs in rows]
-    warm = [_median_range(r["warm_s"] for r in rs) for rs in rows]
-    steps = [sorted({r["lane_steps"] for r in rs}) for rs in rows]
-    assert all(len(s) == 1 for s in steps), steps  # every process of a commit took the same steps
-    assert all(sorted(r["status_counts"].items()) == sorted(rows[0][0]["status_counts"].items()) for rs in rows for r in rs)
+    ab = _ab_per_commit([_drain_rows(c) for c in DRAIN_COMMITS])
+    above, first, warm, steps = ab["above"], ab["first"], ab["warm"], ab["steps"]
+    assert all(st == ab["status"][0] for st in ab["status"])  # the same statuses at every commit
     return (
         f"A first call {above[0]} above a warm one before, {above[1]} with the drain compiled from the start, "
         f"{above[2]} with its width's form of the law; first calls {first[0]}, {first[1]} and {first[2]}; warm calls "
-        f"{warm[0]}, {warm[1]} and {warm[2]}. The same statuses in every process; lane-steps {_sp(steps[0][0])}, "
-        f"{_sp(steps[1][0])} and {_sp(steps[2][0])}"
+        f"{warm[0]}, {warm[1]} and {warm[2]}. The same statuses in every process; lane-steps {steps[0]}, "
+        f"{steps[1]} and {steps[2]}"
     )
 
 
@@ -218,17 +230,12 @@ def _field_rows(commit: str) -> list[dict]:
 def field_ab(commits: tuple[str, str] = FIELD_COMMITS) -> str:
     """A field A/B (stopping, jaxcelt only, the two commits in turn), in words."""
     rows = [_field_rows(c) for c in commits]
-    warm = [_median_range(r["warm_s"] for r in rs) for rs in rows]
-    first = [_median_range(r["first_call_s"] for r in rs) for rs in rows]
+    ab = _ab_per_commit(rows)
+    warm, first, steps, status = ab["warm"], ab["first"], ab["steps"], ab["status"]
     ratio = statistics.median(r["warm_s"] for r in rows[0]) / statistics.median(r["warm_s"] for r in rows[1])
-    steps = [sorted({r["lane_steps"] for r in rs}) for rs in rows]
-    assert all(len(s) == 1 for s in steps), steps  # every process of a commit took the same steps
-    status = [sorted({tuple(sorted(r["status_counts"].items())) for r in rs}) for rs in rows]
-    assert all(len(s) == 1 for s in status), status
     return (
         f"warm calls {warm[1]} against {warm[0]} ({ratio:.2f}×), first calls {first[1]} against {first[0]}; "
-        f"lane-steps {_sp(steps[1][0])} against {_sp(steps[0][0])}, statuses "
-        f"{', '.join(f'{v} × {k}' for k, v in status[1][0])} against {', '.join(f'{v} × {k}' for k, v in status[0][0])}"
+        f"lane-steps {steps[1]} against {steps[0]}, statuses {_statuses(status[1])} against {_statuses(status[0])}"
     )
 
 
