@@ -86,6 +86,32 @@ def test_lyapunov_stage_equals_celt_lyapunov_and_starts_deferred_work(paper_para
     assert o["status"] == 0 and len(ec._MEMORY) == n  # the deferred program, not a new one
 
 
+@pytest.mark.parametrize("n_ok,per_device,n_devices", [(27, 16, 2), (32, 16, 2), (33, 16, 2), (5, 4, 3), (1, 16, 1), (0, 8, 2)])
+def test_lyapunov_groups_deal_every_lane_once_round_robin(n_ok, per_device, n_devices):
+    # The Lyapunov stage's groups: every successful lane computed in exactly one position of its own (the others
+    # are padding), lanes j of a group on device j mod n_devices (device d holds the contiguous block d of the
+    # sharded group), so that the costly first lanes of a cost-ordered group are spread over the devices.
+    from jaxcelt.ensemble.stroboscopic import lyapunov_groups
+
+    rng = np.random.default_rng(0)
+    ok = rng.permutation(100)[:n_ok]
+    groups = lyapunov_groups(ok, per_device, n_devices)
+    G = per_device * n_devices
+    assert len(groups) == -(-n_ok // G)
+    seen = []
+    for g, (idx, own) in enumerate(groups):
+        assert idx.shape == own.shape == (G,)
+        part = ok[g * G : (g + 1) * G]
+        assert set(idx.tolist()) == set(part.tolist())  # padding copies a lane of the group
+        assert own.sum() == len(part)
+        for j, lane in enumerate(part):
+            pos = np.flatnonzero((idx == lane) & own)
+            assert pos.size == 1, (lane, pos)
+            assert pos[0] // per_device == j % n_devices  # the device holding position pos[0]
+        seen += idx[own].tolist()
+    assert sorted(seen) == sorted(ok.tolist())
+
+
 def test_failing_lane_is_isolated(base, paper_params):
     # A lane made stiff (mu = 30: the sticking relaxation rate ~ mu g/(a_hat sqrt(eps)),
     # MODEL.md section 10, grows 130x) exhausts max_steps; it is flagged and the other lanes

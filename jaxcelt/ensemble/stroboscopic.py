@@ -45,7 +45,36 @@ from jaxcelt.ensemble.stepper import float64_times
 from jaxcelt.integrate.lyapunov import celt_lyapunov
 from jaxcelt.physics.params import PARAM_NAMES, CeltParams
 
-__all__ = ["SweepConfig", "lanes_params", "run_lanes", "run_lanes_with_stats", "ENGINES", "check_engine"]
+__all__ = [
+    "SweepConfig", "lanes_params", "run_lanes", "run_lanes_with_stats", "ENGINES", "check_engine",
+    "LYAPUNOV_GROUP_WIDTH", "lyapunov_groups",
+]  # fmt: skip
+
+LYAPUNOV_GROUP_WIDTH = 16
+"""lanes per device in one group of the Lyapunov stage (at most the pool's width). The stage is a vmapped solve: the
+lanes of a group step in lockstep, every lane of the group computed until its slowest one ends each period, and the
+group's compiled width is fixed before the main solve tells how many lanes succeeded, so its last group is padded.
+On a CPU the cost per lane of a group is about flat from 12 to 96 lanes per device and rises below (fixed costs per
+loop iteration), while the padding grows with the width: 16 wastes at most 15 lanes' work per device
+(``benchmarks/lyapunov_stage.py``; docs/internals/sweep-engine.md)."""
+
+
+def lyapunov_groups(ok: np.ndarray, per_device: int, n_devices: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The Lyapunov stage's groups of the lanes ``ok`` (in the order given: costliest first), each as (the lane at
+    every position of the sharded group, the positions holding a lane of its own rather than padding).
+
+    A group has ``per_device`` x ``n_devices`` positions; device d holds the contiguous block of positions
+    d per_device ... (d + 1) per_device - 1, and the group's lanes are dealt over the devices round-robin (lane j
+    of the group to device j mod n_devices), so every device gets a share of the costly and of the cheap lanes,
+    and of the padding of the last group (copies of its last lane)."""
+    G = per_device * n_devices
+    deal = np.arange(G).reshape(-1, n_devices).T.reshape(-1)  # position i holds the group's lane deal[i]
+    groups = []
+    for i in range(0, len(ok), G):
+        part = ok[i : i + G]
+        groups.append((pad_lanes(part, G)[deal], deal < len(part)))
+    return groups
+
 
 def lanes_params(params: CeltParams, name: str, values: Array) -> CeltParams:
     """A batched `CeltParams` with a leading lane axis: field ``name`` = ``values``, others broadcast."""
@@ -163,8 +192,9 @@ def run_lanes(
     schedule (`jaxcelt.ensemble.pool`); ``drain_min_steps`` (default `DRAIN_MIN_STEPS`): the drain's
     narrower widths, a program of their own, run only when a lane left at the end of the
     full-width phase is predicted to need at least this many more steps (0: always). The Lyapunov stage (``cfg.lyapunov_periods > 0``) then
-    runs vmapped over the successful lanes in groups of the pool's width ordered by the measured
-    main-solve step count (a cost estimate that needs no pilot run).
+    runs vmapped over the successful lanes in groups of `LYAPUNOV_GROUP_WIDTH` lanes per device (at most the pool's
+    width), ordered by the measured main-solve step count (a cost estimate that needs no pilot run) and dealt
+    round-robin over the devices (`lyapunov_groups`).
 
     Sharded over ``devices`` (default all local devices; lanes are dealt round-robin); padded
     to ``pad_to`` lanes (so a short last chunk reuses the compiled shape) and to a multiple
@@ -274,7 +304,8 @@ def _run_lanes(
     # kernel boundaries pay on CPU (`jaxcelt.ensemble.kernel_boundary`); on an accelerator a
     # conditional costs a device-to-host sync per stage, so none there
     opaque_true = jnp.asarray(True) if platform == "cpu" else None
-    G = Wd * ndev  # the Lyapunov stage's chunk: the pool's width (a chunk of few lanes solves no padding copies)
+    Gd = min(Wd, LYAPUNOV_GROUP_WIDTH)  # the Lyapunov stage's lanes per device (`LYAPUNOV_GROUP_WIDTH`)
+    G = Gd * ndev
     lyap_fn = _lyap_chunk(platform)
     # The pool's programs and the Lyapunov stage's are traced here, one after the other, and
     # compiled by XLA on worker threads at the same time (XLA releases the GIL while compiling); all
@@ -324,8 +355,7 @@ def _run_lanes(
         # the stage's last group is padded with copies of one lane, which leaves a core idle on a
         # CPU: programs deferred for later (e.g. the CLI's phase plots) are traced and compiled now
         start_deferred()
-        for i in range(0, len(ok), G):
-            idx = pad_lanes(ok[i : i + G], G)
+        for idx, own in lyapunov_groups(ok, Gd, ndev):
             lam, err = lyap(
                 jax.tree_util.tree_map(lambda x, idx=idx: x[idx], pb_np),
                 out["samples"][idx, 0],  # float64 (a float32 pool's samples cast up)
@@ -333,7 +363,6 @@ def _run_lanes(
                 static_cfg,
                 mesh,
             )
-            n = min(G, len(ok) - i)
-            out["lyapunov"][idx[:n]] = np.asarray(lam)[:n]
-            out["lyapunov_stderr"][idx[:n]] = np.asarray(err)[:n]
+            out["lyapunov"][idx[own]] = np.asarray(lam)[own]
+            out["lyapunov_stderr"][idx[own]] = np.asarray(err)[own]
     return out, stats
