@@ -56,6 +56,7 @@ from jaxcelt.ensemble.stepper import FusedStepState as FusedStepState
 from jaxcelt.ensemble.stepper import erk_tableau as erk_tableau
 from jaxcelt.ensemble.stepper import kernel_boundary as kernel_boundary
 from jaxcelt.ensemble.stepper import make_stepper as make_stepper
+from jaxcelt.ensemble.stroboscopic import LYAPUNOV_GROUP_WIDTH as LYAPUNOV_GROUP_WIDTH
 from jaxcelt.ensemble.stroboscopic import lanes_params as lanes_params
 from jaxcelt.ensemble.stroboscopic import run_lanes as run_lanes
 from jaxcelt.ensemble.stroboscopic import run_lanes_with_stats as run_lanes_with_stats  # deprecated

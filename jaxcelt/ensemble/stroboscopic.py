@@ -352,7 +352,7 @@ def _run_lanes(
         ok = np.flatnonzero(out["status"] == 0)
         ok = ok[np.argsort(-out["num_steps"][ok], kind="stable")]  # similar cost side by side
         lyap = lyap_compiled.result()
-        # the stage's last group is padded with copies of one lane, which leaves a core idle on a
+        # the stage's last group is padded with copies of one lane, which leaves a core partly idle on a
         # CPU: programs deferred for later (e.g. the CLI's phase plots) are traced and compiled now
         start_deferred()
         for idx, own in lyapunov_groups(ok, Gd, ndev):

@@ -110,7 +110,7 @@ def prepare_dense_trajectory(
     e.g. drawing figures. Raises as `dense_trajectory` does on bad input.
 
     ``defer=True``: trace and compile it on a worker thread when a sweep's Lyapunov stage starts
-    (its padded last group leaves a core idle), or else when `dense_trajectory` or this function without
+    (its padded last group leaves a core partly idle), or else when `dense_trajectory` or this function without
     ``defer`` first asks for it (`jaxcelt._executable_cache.start_deferred`)."""
     fn, args, description, _ = _program(
         params, y0, transient_periods, periods, points_per_period, solver, rtol, atol, max_steps, contact_law
