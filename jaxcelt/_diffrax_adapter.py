@@ -24,6 +24,7 @@ import threading
 from typing import Any
 
 import diffrax
+import equinox as eqx
 import equinox.internal as eqxi
 import jax
 import jax.numpy as jnp
@@ -40,6 +41,7 @@ __all__ = [
     "loop_init",
     "loop_step",
     "solve_to",
+    "forward_only",
     "runtime_checks_as_nan",
     "compact_end_rounding",
     "diffeqsolve",
@@ -217,6 +219,17 @@ def loop_step(
     return keep, y1, tprev1, tnext1, sstate1, cstate1, sres, cres
 
 
+def forward_only(solver: diffrax.AbstractSolver) -> diffrax.AbstractSolver:
+    """``solver`` for a solve that is never differentiated in reverse mode: a Runge-Kutta solver with diffrax's
+    default ``scan_kind`` (None: its stages in a checkpointed loop, which keeps reverse mode's memory bounded) gets
+    ``scan_kind="lax"`` (the same stages in a plain `jax.lax.while_loop`): the same arithmetic in a program that
+    compiles faster (the Lyapunov stage's: ``benchmarks/lyapunov_stage.py``). Other solvers, and a ``scan_kind``
+    the caller chose, are returned as they are."""
+    if isinstance(solver, diffrax.AbstractRungeKutta) and solver.scan_kind is None:
+        return eqx.tree_at(lambda s: s.scan_kind, solver, "lax", is_leaf=lambda x: x is None)
+    return solver
+
+
 def solve_to(
     solver: diffrax.AbstractSolver,
     term: diffrax.AbstractTerm,
@@ -233,8 +246,10 @@ def solve_to(
 
     The same steps as diffeqsolve, in a smaller program: no saving, event or adjoint machinery,
     and t1's 100-ULP floor computed in a loop (`t1_clip_floor`). Differentiable in forward mode
-    (``jax.jvp``, ``jax.jacfwd``); reverse mode is not supported (a while loop)."""
+    (``jax.jvp``, ``jax.jacfwd``); reverse mode is not supported (a while loop), so a Runge-Kutta
+    solver's stages run in a plain loop (`forward_only`)."""
     R = diffrax.RESULTS
+    solver = forward_only(solver)
     wterm = wrap_term(term)
     tnext, cstate, sstate = loop_init(solver, wterm, controller, t0, t1, y0, args)
     floor = t1_clip_floor(t1)

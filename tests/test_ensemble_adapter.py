@@ -193,6 +193,18 @@ def test_solve_to_takes_diffeqsolve_steps(solver):
             assert sol.result == diffrax.RESULTS.max_steps_reached
 
 
+def test_forward_only_plain_stage_loop_where_diffrax_chose():
+    # solve_to's solvers: a Runge-Kutta solver left at diffrax's default scan_kind (None: checkpointed stages, for
+    # reverse mode) gets the plain loop; a scan_kind the caller chose and solvers without stages are kept
+    assert ad.forward_only(diffrax.Tsit5()).scan_kind == "lax"
+    assert ad.forward_only(diffrax.Kvaerno5()).scan_kind == "lax"
+    kept = diffrax.Tsit5(scan_kind="bounded")
+    assert ad.forward_only(kept) is kept
+    euler = diffrax.Euler()
+    assert ad.forward_only(euler) is euler
+    assert diffrax.Tsit5().scan_kind is None  # the default this relies on
+
+
 def test_runtime_checks_as_nan_removes_host_callbacks():
     """Inside `runtime_checks_as_nan` a traced `eqx.error_if` lowers without a host callback and
     returns NaN where it would raise; outside, equinox's default (a callback that raises) holds --
