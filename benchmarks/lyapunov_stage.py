@@ -10,12 +10,15 @@ costliest first (`jaxcelt.ensemble.run_lanes`' order), is run as groups of a fix
 * ``round-robin``: groups of ``--widths`` lanes per device, the group's lanes dealt over the devices round-robin
   (`lyapunov_groups`, with `LYAPUNOV_GROUP_WIDTH` the library's default).
 
-Each layout's program is compiled first (compile time reported apart), then the stage is timed ``--reps`` times in
-turn with the others (medians). Reports the groups, the padding positions, and how far each layout's exponents are
-from the contiguous layout's (another compiled program: rounding differs, and a finite-time exponent of a chaotic
-lane amplifies it).
+Each layout's program is traced and lowered, then compiled by XLA, each timed apart (JAX's persistent cache is not
+used here; a width compiled before in the process is found compiled), then the stage is timed ``--reps`` times in
+turn with the others (medians). Reports the groups, the padding positions, and the speed and exponents of each
+layout against the first one (``speedup_vs_contiguous``, ``max_abs_lyapunov_difference_vs_contiguous``: the
+contiguous layout, or with ``--no-contiguous`` the first of ``--widths``); the exponents differ (another compiled
+program: rounding differs, and a finite-time exponent of a chaotic lane amplifies it).
 
     .venv/bin/python benchmarks/lyapunov_stage.py --out docs/bifurcation/lyapunov_stage.json
+    .venv/bin/python benchmarks/lyapunov_stage.py --widths 16 --no-contiguous --out /tmp/stage.json   # one layout
 """
 
 from __future__ import annotations
@@ -35,6 +38,7 @@ def main() -> int:
     ap.add_argument("--lyapunov", type=int, default=150, help="periods of the exponent's window")
     ap.add_argument("--widths", default="8,12,16,24", help="round-robin group widths per device, comma-separated")
     ap.add_argument("--reps", type=int, default=3)
+    ap.add_argument("--no-contiguous", action="store_true", help="leave out the contiguous layout")
     ap.add_argument("--out", type=Path, default=Path("docs/bifurcation/lyapunov_stage.json"))
     a = ap.parse_args()
     jax.config.update("jax_num_cpu_devices", os.cpu_count() or 1)
@@ -67,33 +71,43 @@ def main() -> int:
         G = per_device * ndev
         return [(sb.pad_lanes(ok[i : i + G], G), np.arange(G) < len(ok[i : i + G])) for i in range(0, len(ok), G)]
 
-    layouts = {f"contiguous {pool_per_device}": contiguous(pool_per_device)}
+    layouts = {} if a.no_contiguous else {f"contiguous {pool_per_device}": contiguous(pool_per_device)}
     for w in (int(x) for x in a.widths.split(",")):
         layouts[f"round-robin {w}"] = sb.lyapunov_groups(ok, w, ndev)
 
-    def run(groups):
+    def args(idx):
+        return jax.tree_util.tree_map(lambda v: v[idx], pb_np), out["samples"][idx, 0], out["t_samples"][idx, 0]
+
+    def run(program, groups):
         lam = np.full(a.n_freq, np.nan)
         for idx, own in groups:
-            x, _ = lyap(jax.tree_util.tree_map(lambda v, idx=idx: v[idx], pb_np), out["samples"][idx, 0],
-                        out["t_samples"][idx, 0], lcfg, mesh)  # fmt: skip
+            x, _ = program(*args(idx), lcfg, mesh)
             lam[idx[own]] = np.asarray(x)[own]
         return lam
 
-    rows = {}
+    rows, programs = {}, {}
     for name, groups in layouts.items():
         t = time.perf_counter()
-        lam = run(groups)  # compiles this width's program, then runs
+        lowered = lyap.lower(*args(groups[0][0]), lcfg, mesh)
+        t_lower = time.perf_counter() - t
+        programs[name] = lowered.compile()
+        t_compile = time.perf_counter() - t - t_lower
+        t = time.perf_counter()
+        lam = run(programs[name], groups)
         rows[name] = {"groups": len(groups), "lanes_per_device": int(groups[0][0].size // ndev),
                       "padding_positions": int(sum((~own).sum() for _, own in groups)),
-                      "first_call_s": time.perf_counter() - t, "warm_each_s": [], "lyapunov": lam}  # fmt: skip
+                      "trace_and_lower_s": t_lower, "xla_compile_s": t_compile,
+                      "first_call_s": t_lower + t_compile + time.perf_counter() - t, "warm_each_s": [],
+                      "lyapunov": lam}  # fmt: skip
     for _ in range(a.reps):
         for name, groups in layouts.items():
             t = time.perf_counter()
-            run(groups)
+            run(programs[name], groups)
             rows[name]["warm_each_s"].append(time.perf_counter() - t)
-    base = rows[f"contiguous {pool_per_device}"]
+    base = next(iter(rows.values()))  # the contiguous layout, unless left out
     print(f"\n{len(ok)} successful lanes of {a.n_freq}, {ndev} devices, the pool's width {pool_per_device} per device")
-    print(f"{'layout':<18}{'groups':>7}{'padding':>9}{'first call':>12}{'warm':>9}{'vs contiguous':>15}{'max |dlambda|':>15}")
+    print(f"{'layout':<18}{'groups':>7}{'padding':>9}{'lower':>8}{'XLA':>8}{'first call':>12}{'warm':>9}"
+          f"{'vs first row':>14}{'max |dlambda|':>15}")
     base_lam = np.asarray(base["lyapunov"])
     for name, r in rows.items():
         r["warm_s"] = float(np.median(r["warm_each_s"]))
@@ -101,7 +115,8 @@ def main() -> int:
         d = np.abs(np.asarray(r["lyapunov"])[ok] - base_lam[ok])
         r["max_abs_lyapunov_difference_vs_contiguous"] = float(np.max(d)) if d.size else 0.0
         r["lyapunov"] = [None if not np.isfinite(v) else float(v) for v in r["lyapunov"]]
-        print(f"{name:<18}{r['groups']:>7}{r['padding_positions']:>9}{r['first_call_s']:>11.2f}s{r['warm_s']:>8.2f}s"
+        print(f"{name:<18}{r['groups']:>7}{r['padding_positions']:>9}{r['trace_and_lower_s']:>7.2f}s"
+              f"{r['xla_compile_s']:>7.2f}s{r['first_call_s']:>11.2f}s{r['warm_s']:>8.2f}s"
               f"{r['speedup_vs_contiguous']:>14.2f}x{r['max_abs_lyapunov_difference_vs_contiguous']:>15.2e}")  # fmt: skip
     res = {"config": {"n_freq": a.n_freq, "transient_periods": 100, "sample_periods": 30, "lyapunov_periods": a.lyapunov,
                       "rtol": 1e-8, "atol": 1e-10, "stop_on_invalid": True, "reps": a.reps},
