@@ -26,7 +26,7 @@ def stage_rows() -> str:
             f"| {name} | {r['groups']} | {r['padding_positions']} | {r['first_call_s']:.1f} | {r['warm_s']:.1f} | "
             f"{r['speedup_vs_contiguous']:.2f}× | {r['max_abs_lyapunov_difference_vs_contiguous']:.1e} |"
         )
-    return "\n".join(rows)
+    return " ".join(rows)  # a table's rows, its line breaks read as spaces (`_prose`)
 
 
 def stage_setting() -> str:
@@ -62,3 +62,30 @@ def main_job_ab() -> str:
 
 
 QUOTES = [(PAGE, stage_rows), (PAGE, stage_setting), (PAGE, main_job_ab)]
+
+
+STAGE_AB = "docs/performance/lyapunov_ab/stage_{commit}_{i}.json"
+STAGE_AB_COMMITS = ("008e79c", "c238b14")  # before; solve_to's Runge-Kutta stages in a plain loop (forward_only)
+
+
+def _stage_rows(commit: str) -> list[dict]:
+    return [d["layouts"]["round-robin 16"] for d in _runs_of(STAGE_AB, commit, 3)]
+
+
+def stage_loop_ab() -> str:
+    """The Lyapunov stage's program at the two commits (three fresh processes each, alternating), in words."""
+    a, b = (_stage_rows(c) for c in STAGE_AB_COMMITS)
+
+    def mr(rows, key):
+        v = [r[key] for r in rows]
+        return f"{statistics.median(v):.2f} s ({min(v):.2f}–{max(v):.2f} s)"
+
+    warm = lambda rows: ", ".join(f"{x:.2f}" for r in rows for x in r["warm_each_s"])  # noqa: E731
+    return (
+        f"XLA compiled it in {mr(b, 'xla_compile_s')} against {mr(a, 'xla_compile_s')}; tracing and lowering took "
+        f"{mr(b, 'trace_and_lower_s')} against {mr(a, 'trace_and_lower_s')}. Its warm calls took {warm(b)} s against "
+        f"{warm(a)} s"
+    )
+
+
+QUOTES += [(PAGE, stage_loop_ab)]
