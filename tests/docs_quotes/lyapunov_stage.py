@@ -42,9 +42,9 @@ def _mj(commit: str) -> list[dict]:
     return _runs_of(AB, commit, 2)
 
 
-def main_job_ab() -> str:
+def main_job_ab(commits: tuple[str, str] = AB_COMMITS) -> str:
     """The main job, whole command, at the two commits (two fresh processes each, alternating), in words."""
-    a, b = (_mj(c) for c in AB_COMMITS)
+    a, b = (_mj(c) for c in commits)
 
     def both(runs, f):
         return " and ".join(f"{f(d):.1f} s" for d in runs)
@@ -88,4 +88,4 @@ def stage_loop_ab() -> str:
     )
 
 
-QUOTES += [(PAGE, stage_loop_ab)]
+QUOTES += [(PAGE, stage_loop_ab), (PAGE, lambda: main_job_ab(STAGE_AB_COMMITS))]
