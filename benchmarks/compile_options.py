@@ -32,7 +32,7 @@ def child(variant: str) -> dict:
     import jaxcelt as jc
     from jaxcelt._compile_options import LOOP_EMITTERS
     from jaxcelt.ensemble import stroboscopic as sb
-    from jaxcelt.ensemble.shard import device_mesh, pad_lanes
+    from jaxcelt.ensemble.shard import device_mesh
 
     p = jc.CeltParams.paper()
     vals = np.linspace(10.0, 20.0, 60)
@@ -44,8 +44,9 @@ def child(variant: str) -> dict:
     mesh = device_mesh(None)
     ndev = mesh.devices.size
     ok = np.flatnonzero(out["status"] == 0)
-    G = st.width * ndev  # as run_lanes: one chunk of the pool's width
-    idx = pad_lanes(ok[:G], G)
+    # as run_lanes: the first group of the Lyapunov stage (`jaxcelt.ensemble.stroboscopic.lyapunov_groups`); the
+    # committed compile_options.json was measured before it, with one group of the pool's width in contiguous blocks
+    idx, own = sb.lyapunov_groups(ok, min(st.width, sb.LYAPUNOV_GROUP_WIDTH), ndev)[0]
     pb_np = jax.tree_util.tree_map(np.asarray, pb)
     args = (jax.tree_util.tree_map(lambda x: x[idx], pb_np), out["samples"][idx, 0], out["t_samples"][idx, 0], lcfg, mesh)
     fn = eqx.filter_jit(sb._lyap_chunk_impl, compiler_options=LOOP_EMITTERS if variant == "loop" else None)
@@ -60,10 +61,10 @@ def child(variant: str) -> dict:
         t = time.perf_counter()
         lam = np.asarray(jax.block_until_ready(compiled(*args)))
         runs.append(time.perf_counter() - t)
-    n = min(G, len(ok))
+    n = int(own.sum())
     return dict(
         variant=variant, lanes=int(n), trace_lower_s=trace_s, compile_s=compile_s, run_best_of_3_s=min(runs),
-        lyapunov=lam[:n].tolist(),
+        lyapunov=lam[own].tolist(),  # the group's own lanes, in the order of their positions
     )  # fmt: skip
 
 
