@@ -13,7 +13,7 @@ from typing import Any
 import jax
 import numpy as np
 
-__all__ = ["device_mesh", "shard_lanes", "pad_lanes", "LANE_AXIS"]
+__all__ = ["device_mesh", "shard_lanes", "pad_lanes", "dealt_positions", "LANE_AXIS"]
 
 LANE_AXIS = "lanes"
 
@@ -40,3 +40,10 @@ def pad_lanes(x: np.ndarray, n: int) -> np.ndarray:
     if len(x) == n:
         return x
     return np.concatenate([x, np.repeat(x[-1:], n - len(x), axis=0)])
+
+
+def dealt_positions(n: int, n_devices: int) -> np.ndarray:
+    """Lanes 0 .. n - 1 (``n`` a multiple of ``n_devices``) dealt round-robin over the devices of a sharded lane axis:
+    position i holds lane ``dealt_positions(n, n_devices)[i]``. Device d holds the contiguous block of positions
+    d n / n_devices ... (d + 1) n / n_devices - 1, so it gets lanes d, d + n_devices, d + 2 n_devices, ..."""
+    return np.arange(n).reshape(-1, n_devices).T.reshape(-1)

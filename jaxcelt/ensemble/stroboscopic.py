@@ -40,7 +40,7 @@ from jaxcelt.ensemble.pool import (
     start_lanes,
 )
 from jaxcelt.ensemble.runners import AbstractLaneRunner
-from jaxcelt.ensemble.shard import device_mesh, pad_lanes, shard_lanes
+from jaxcelt.ensemble.shard import dealt_positions, device_mesh, pad_lanes, shard_lanes
 from jaxcelt.ensemble.stepper import float64_times
 from jaxcelt.integrate.lyapunov import celt_lyapunov
 from jaxcelt.physics.params import PARAM_NAMES, CeltParams
@@ -68,7 +68,7 @@ def lyapunov_groups(ok: np.ndarray, per_device: int, n_devices: int) -> list[tup
     of the group to device j mod n_devices), so every device gets a share of the costly and of the cheap lanes,
     and of the padding of the last group (copies of its last lane)."""
     G = per_device * n_devices
-    deal = np.arange(G).reshape(-1, n_devices).T.reshape(-1)  # position i holds the group's lane deal[i]
+    deal = dealt_positions(G, n_devices)  # position i holds the group's lane deal[i]
     groups = []
     for i in range(0, len(ok), G):
         part = ok[i : i + G]
@@ -295,7 +295,7 @@ def _run_lanes(
     Wd = min(W, Lloc)
     # position i of the sharded arrays holds lane pos_lane[i]; device d holds positions
     # d Lloc ... (d + 1) Lloc - 1 and gets lanes d, d + ndev, ... (a mix of cheap and costly)
-    pos_lane = np.arange(Lp).reshape(-1, ndev).T.reshape(-1)
+    pos_lane = dealt_positions(Lp, ndev)
     pb_p = jax.tree_util.tree_map(lambda x: x[pos_lane].astype(dt), pb_np)
     live = (pos_lane < L) & (not compile_only)
     tols = jnp.asarray([cfg.rtol, cfg.atol], dt)

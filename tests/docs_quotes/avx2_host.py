@@ -9,6 +9,7 @@ Each entry is (document, function returning the quoted text).
 from __future__ import annotations
 
 from .files import _json
+from .pool_programs import perf_latest
 
 PAGE = "docs/performance.md"
 TABLE = "docs/performance/numba_table_400x300_avx2.json"
@@ -18,15 +19,7 @@ FIT = "docs/fit/bench_fit_avx2.json"
 
 def table() -> str:
     """The table against numba on the AVX2 host, in words."""
-    m = _json(TABLE)["modes"]
-    s, o = m["stop"], m["on"]
-    return (
-        f"stopping, warm {s['jaxcelt']['warm_s']:.1f} s against numba's {s['numba']['warm_s']:.1f} s "
-        f"({s['warm_speedup_vs_numba']:.2f}×), a first call {s['jaxcelt']['first_call_s']:.1f} s against "
-        f"{s['numba']['first_call_s']:.1f} s; integrating on, warm {o['jaxcelt']['warm_s']:.1f} s against "
-        f"{o['numba']['warm_s']:.1f} s ({o['warm_speedup_vs_numba']:.2f}×), a first call "
-        f"{o['jaxcelt']['first_call_s']:.1f} s against {o['numba']['first_call_s']:.1f} s"
-    )
+    return perf_latest(TABLE, ratios=True)
 
 
 def roofline() -> str:

@@ -193,14 +193,15 @@ def rerun3_compile() -> str:
 QUOTES += [(PAGE, drain_ab), (PAGE, lambda: rerun(RERUN3)), (PAGE, rerun3_compile)]
 
 
-def perf_latest() -> str:
-    """The final table on the performance page, in words."""
-    m = _json(RERUN5)["modes"]
+def perf_latest(path: str | None = None, ratios: bool = False) -> str:
+    """A table against numba on the performance page (default `RERUN5`), in words (``ratios``: with the warm ratios)."""
+    m = _json(path or RERUN5)["modes"]
     s, o = m["stop"], m["on"]
+    r = (lambda row: f" ({row['warm_speedup_vs_numba']:.2f}×)") if ratios else (lambda row: "")  # noqa: E731
     return (
-        f"stopping, warm {s['jaxcelt']['warm_s']:.1f} s against numba's {s['numba']['warm_s']:.1f} s, a first call "
+        f"stopping, warm {s['jaxcelt']['warm_s']:.1f} s against numba's {s['numba']['warm_s']:.1f} s{r(s)}, a first call "
         f"{s['jaxcelt']['first_call_s']:.1f} s against {s['numba']['first_call_s']:.1f} s; integrating on, warm "
-        f"{o['jaxcelt']['warm_s']:.1f} s against {o['numba']['warm_s']:.1f} s, a first call {o['jaxcelt']['first_call_s']:.1f} s "
+        f"{o['jaxcelt']['warm_s']:.1f} s against {o['numba']['warm_s']:.1f} s{r(o)}, a first call {o['jaxcelt']['first_call_s']:.1f} s "
         f"against {o['numba']['first_call_s']:.1f} s"
     )
 
