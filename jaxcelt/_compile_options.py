@@ -29,17 +29,24 @@ stepper's initialisation, is the same arithmetic; see docs/internals/compilation
 with and without). The pool's stepping program keeps the default emitters or the wide vectors above: it is where
 the run time goes.
 
-JAX takes compiler options only on a top-level ``jax.jit``, so they are given to programs that
-are never called inside another trace: the fit's evaluation program and its optimisers' step programs (small
-programs with a host callback, which gain nothing from the fusion emitters either), the sweep's Lyapunov stage
-(`jit_per_platform`), not `jaxcelt.simulate`, which users call inside their own ``jit``, ``vmap`` and ``grad``.
+JAX takes compiler options only on a top-level ``jax.jit``. Programs never called inside another trace get them
+directly: the fit's evaluation program and its optimisers' step programs (small programs with a host callback, which
+gain nothing from the fusion emitters either), the sweep's Lyapunov stage (`jit_per_platform`). The programs of
+periodic orbits and their continuation (`jaxcelt.periodic_orbit`, the arclength stepper's tangent, corrector and
+multipliers, the curves' start) and of the Lyapunov spectrum hold a solve with its forward-mode tangents too, but are
+public functions or their parts, which users may call inside their own ``jit``: `jit_anywhere` gives them the
+options at top level and the plain program inside another trace (``benchmarks/orbit_compile.py``). Not
+`jaxcelt.simulate`: a plain solve, whose run time the fusion emitters may serve better.
 """
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
+from typing import Any
 
 import equinox as eqx
+import jax
 
 LOOP_EMITTERS = {"xla_cpu_use_fusion_emitters": False}
 WIDE_VECTORS = {"xla_cpu_prefer_vector_width": 512}
@@ -58,6 +65,38 @@ def jit_per_platform(fn: Callable) -> Callable[[str], Callable]:
     called at top level (JAX takes compiler options there alone)."""
     jits = {kind: eqx.filter_jit(fn, compiler_options=compiler_options(kind)) for kind in ("cpu", "other")}
     return lambda platform: jits["cpu" if platform == "cpu" else "other"]
+
+
+def jit_anywhere(fn: Callable, *, filter_jit: bool = True) -> Callable:
+    """``fn`` jitted (``equinox.filter_jit``, or ``jax.jit`` with ``filter_jit=False``) with `compiler_options` of
+    the default backend wherever JAX allows them, for programs that are also public functions or their parts.
+
+    Called at top level (or under ``jax.vmap``), the program is compiled with the options; called inside another
+    trace (a user's ``jax.jit``, a scan, ...), where JAX refuses compiler options on a nested jit, it is the plain
+    jitted ``fn`` and the outer program's options apply. The same values either way, to rounding (another compiled
+    program). ``.lower`` lowers the top-level program."""
+    jits = {kind: (eqx.filter_jit if filter_jit else jax.jit)(fn, compiler_options=compiler_options(kind))
+            for kind in ("cpu", "other")}  # fmt: skip
+
+    def top() -> Callable:
+        return jits["cpu" if jax.default_backend() == "cpu" else "other"]
+
+    @functools.wraps(fn)
+    def call(*args: Any, **kwargs: Any) -> Any:
+        program = top()
+        if program is jits["other"]:  # no options: nothing to fall back from
+            return program(*args, **kwargs)
+        try:
+            return program(*args, **kwargs)
+        except ValueError as err:
+            # JAX: "`compiler_options` can only be passed to top-level `jax.jit`" (raised while staging, before any
+            # computation); inside another trace the options of the outermost program apply
+            if "compiler_options" not in str(err) or "top-level" not in str(err):
+                raise
+            return jits["other"](*args, **kwargs)
+
+    call.lower = lambda *args, **kwargs: top().lower(*args, **kwargs)  # type: ignore[attr-defined]
+    return call
 
 
 def is_wide_pool(platform: str, slots: int) -> bool:

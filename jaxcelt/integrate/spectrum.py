@@ -30,12 +30,12 @@ from collections.abc import Callable
 from typing import Any, NamedTuple
 
 import diffrax
-import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
 
 from jaxcelt import _config  # noqa: F401
+from jaxcelt._compile_options import jit_anywhere
 from jaxcelt._diffrax_adapter import solve_to
 from jaxcelt._types import Array
 from jaxcelt.integrate.lyapunov import STDERR_BLOCKS, celt_tangent_projection, exponent_stderr
@@ -234,7 +234,7 @@ def lyapunov_spectrum(
     )
 
 
-@eqx.filter_jit
+@jit_anywhere
 def _celt_spectrum(params, y0, t0, *, law, periods, transient, per_period, solver, rtol, atol, max_steps):
     T = 2 * jnp.pi / params.omega_pi
     res = lyapunov_spectrum(

@@ -33,6 +33,7 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
+from jaxcelt._compile_options import jit_anywhere
 from jaxcelt._types import Array
 from jaxcelt.orbits.options import ShootingKeywords, ShootingOptions, resolve_options
 from jaxcelt.orbits.points import Bifurcation, detect_on_arclength_branch, detect_on_natural_branch
@@ -107,7 +108,7 @@ def continue_natural(
     """
     values = np.asarray(values, dtype=float)
 
-    @jax.jit
+    @functools.partial(jit_anywhere, filter_jit=False)
     def solve(lam, y0):
         args = args_of(lam)
         return find_periodic_orbit(vector_field, y0, args, period=period_of(args), **find_kw)
@@ -187,14 +188,14 @@ class ArclengthStepper(NamedTuple):
 
     @classmethod
     def build(cls, residual, recentre, observe, *, newton_tol: float, newton_max_steps: int) -> ArclengthStepper:
-        @jax.jit
+        @functools.partial(jit_anywhere, filter_jit=False)
         def tangent(u, ref, t_prev):
             J = jax.jacfwd(lambda v: residual(v, ref)[0])(u)
             _, _, vt = jnp.linalg.svd(J)
             t = vt[-1]
             return t * jnp.sign(jnp.dot(t, t_prev) + 1e-300)
 
-        @jax.jit
+        @functools.partial(jit_anywhere, filter_jit=False)
         def corrector(u_prev, t, h, ref):
             pred = u_prev + h * t
 
@@ -209,7 +210,9 @@ class ArclengthStepper(NamedTuple):
             good = good & (jnp.max(jnp.abs(res)) < 10 * newton_tol)
             return u, good, sol.stats["num_steps"]
 
-        return cls(tangent, corrector, jax.jit(recentre), jax.jit(observe))
+        return cls(
+            tangent, corrector, jit_anywhere(recentre, filter_jit=False), jit_anywhere(observe, filter_jit=False)
+        )
 
 
 class _FixedOrbit(NamedTuple):
@@ -244,7 +247,7 @@ class _FixedLamSolve(NamedTuple):
 @functools.lru_cache(maxsize=16)
 def _cached_family_programs(family: OrbitFamily) -> tuple[Callable, ArclengthStepper]:
     cold = dataclasses.replace(family.options, newton_max_steps=_COLD_NEWTON_STEPS)
-    first = jax.jit(lambda lam, y0: family.solve(lam, y0, cold))
+    first = jit_anywhere(lambda lam, y0: family.solve(lam, y0, cold), filter_jit=False)
     return first, ArclengthStepper.build(
         family.residual, family.recentre, family.multipliers, newton_tol=family.options.newton_tol,
         newton_max_steps=family.options.newton_max_steps,

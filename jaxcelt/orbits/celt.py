@@ -39,6 +39,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxcelt import _config  # noqa: F401
+from jaxcelt._compile_options import jit_anywhere
 from jaxcelt._types import Array, ArrayLike, Scalar
 from jaxcelt.orbits.branch import ArclengthBranch, continue_arclength
 from jaxcelt.orbits.options import ShootingKeywords, ShootingOptions, resolve_options
@@ -182,7 +183,7 @@ def _period(params: CeltParams) -> Array:
     return 2 * jnp.pi / params.omega_pi
 
 
-@eqx.filter_jit
+@jit_anywhere
 def _orbit(params, y_guess, t0, *, k, law, options):
     T = _period(params)
     field = CeltField(law)

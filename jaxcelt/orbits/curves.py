@@ -53,6 +53,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxcelt import _config  # noqa: F401
+from jaxcelt._compile_options import jit_anywhere
 from jaxcelt._types import Array
 from jaxcelt.orbits.branch import ArclengthStepper, trace_arclength
 from jaxcelt.orbits.curve_fold import FoldSystem, codim2_tests
@@ -333,7 +334,7 @@ def _identity(z: Array, ref: Array, args: Any) -> Array:
 
 @functools.lru_cache(maxsize=16)
 def _cached_stepper(curve: FoldSystem | NSSystem) -> tuple[Callable, ArclengthStepper]:
-    return jax.jit(curve.start), ArclengthStepper.build(
+    return jit_anywhere(curve.start, filter_jit=False), ArclengthStepper.build(
         curve.residual, curve.recentre, curve.observe, newton_tol=curve.options.newton_tol,
         newton_max_steps=curve.options.newton_max_steps,
     )  # fmt: skip

@@ -20,6 +20,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from jaxcelt._compile_options import jit_anywhere
 from jaxcelt._diffrax_adapter import diffeqsolve
 from jaxcelt.orbits.shooting import find_periodic_orbit
 from jaxcelt.sweeps.continuation_core import LaneBatch, Refined, SectionModel, _identity
@@ -51,7 +52,7 @@ def _lanes(field, solver, y0s, args, period, transient, n_samples, rtol, atol, m
     return ts, ys, ok
 
 
-@eqx.filter_jit
+@jit_anywhere
 def _orbit(field, y, args, period, t0, *, k, options):
     orb = find_periodic_orbit(field, y, args, period=period, k=k, t0=t0, options=options)
     return orb.status, orb.y, jnp.abs(orb.multipliers)
