@@ -63,8 +63,13 @@ def jit_per_platform(fn: Callable) -> Callable[[str], Callable]:
     """``fn`` as one ``equinox.filter_jit`` program per kind of platform, each compiled with `compiler_options` of
     its platform: ``jit_per_platform(fn)(platform)`` is the jitted ``fn`` to call on ``platform``. Only for programs
     called at top level (JAX takes compiler options there alone)."""
-    jits = {kind: eqx.filter_jit(fn, compiler_options=compiler_options(kind)) for kind in ("cpu", "other")}
+    jits = _jits_per_kind(fn, eqx.filter_jit)
     return lambda platform: jits["cpu" if platform == "cpu" else "other"]
+
+
+def _jits_per_kind(fn: Callable, jit: Callable) -> dict[str, Callable]:
+    """``jit(fn)`` with the `compiler_options` of each kind of platform ("cpu", "other")."""
+    return {kind: jit(fn, compiler_options=compiler_options(kind)) for kind in ("cpu", "other")}
 
 
 def jit_anywhere(fn: Callable, *, filter_jit: bool = True) -> Callable:
@@ -74,9 +79,9 @@ def jit_anywhere(fn: Callable, *, filter_jit: bool = True) -> Callable:
     Called at top level (or under ``jax.vmap``), the program is compiled with the options; called inside another
     trace (a user's ``jax.jit``, a scan, ...), where JAX refuses compiler options on a nested jit, it is the plain
     jitted ``fn`` and the outer program's options apply. The same values either way, to rounding (another compiled
-    program). ``.lower`` lowers the top-level program."""
-    jits = {kind: (eqx.filter_jit if filter_jit else jax.jit)(fn, compiler_options=compiler_options(kind))
-            for kind in ("cpu", "other")}  # fmt: skip
+    program). Inside another trace the function is traced twice (the first attempt stops at JAX's refusal), once per
+    compilation of the outer program. ``.lower`` lowers the top-level program."""
+    jits = _jits_per_kind(fn, eqx.filter_jit if filter_jit else jax.jit)
 
     def top() -> Callable:
         return jits["cpu" if jax.default_backend() == "cpu" else "other"]

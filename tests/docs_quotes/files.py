@@ -34,6 +34,16 @@ def _runs_of(pattern: str, commit: str, n: int) -> list[dict]:
     return out
 
 
+def _same_orbit(ds: list[dict]) -> str:
+    """'Newton steps N, branch points M, multipliers' of ``benchmarks/orbit_compile.py`` runs, each asserted the same
+    in every run (the multipliers to six decimals)."""
+    steps = {d["newton_steps"] for d in ds}
+    points = {d["branch_points"] for d in ds}
+    mults = {tuple(f"{m:.6f}" for m in d["multipliers_abs"]) for d in ds}
+    assert len(steps) == len(points) == len(mults) == 1
+    return f"Newton steps {steps.pop()}, branch points {points.pop()}, multipliers"
+
+
 def _lm_runs(pattern: str, commit: str, n: int) -> list[dict]:
     """The no-noise Levenberg-Marquardt rows of an alternating A/B's ``benchmarks/bench_fit.py`` files (`_runs_of`)."""
     return [next(r for r in d["rows"] if r["noise"] == 0.0) for d in _runs_of(pattern, commit, n)]

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import statistics
 
-from .files import _fit_same, _fit_table_rows, _lm_runs, _runs_of
+from .files import _fit_same, _fit_table_rows, _lm_runs, _runs_of, _same_orbit
 
 PAGE = "docs/internals/compilation.md"
 BEFORE, AFTER = "c2eb159", "8ea00d0"
@@ -49,12 +49,7 @@ def _orbit_rows() -> list[str]:
 
 
 def _orbit_same() -> str:
-    ds = _orbit(BEFORE) + _orbit(AFTER)
-    steps = {d["newton_steps"] for d in ds}
-    points = {d["branch_points"] for d in ds}
-    mults = {tuple(f"{m:.6f}" for m in d["multipliers_abs"]) for d in ds}
-    assert len(steps) == len(points) == len(mults) == 1
-    return f"the same orbit on both commits (Newton steps {steps.pop()}, branch points {points.pop()}, multipliers"
+    return f"the same orbit on both commits ({_same_orbit(_orbit(BEFORE) + _orbit(AFTER))}"
 
 
 QUOTES = [
