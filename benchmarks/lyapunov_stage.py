@@ -19,6 +19,10 @@ program: rounding differs, and a finite-time exponent of a chaotic lane amplifie
 
     .venv/bin/python benchmarks/lyapunov_stage.py --out docs/bifurcation/lyapunov_stage.json
     .venv/bin/python benchmarks/lyapunov_stage.py --widths 16 --no-contiguous --out /tmp/stage.json   # one layout
+
+``--error-control state|all``: what the stage's step-size control measures (`jaxcelt.SweepOptions`'
+``lyapunov_error_control``; default the library's); the per-lane exponents and their standard errors are written
+for comparing two runs.
 """
 
 from __future__ import annotations
@@ -39,6 +43,8 @@ def main() -> int:
     ap.add_argument("--widths", default="8,12,16,24", help="round-robin group widths per device, comma-separated")
     ap.add_argument("--reps", type=int, default=3)
     ap.add_argument("--no-contiguous", action="store_true", help="leave out the contiguous layout")
+    ap.add_argument("--error-control", default=None, choices=("state", "all"),
+                    help="what the stage's step-size control measures (default: the library's)")  # fmt: skip
     ap.add_argument("--out", type=Path, default=Path("docs/bifurcation/lyapunov_stage.json"))
     a = ap.parse_args()
     jax.config.update("jax_num_cpu_devices", os.cpu_count() or 1)
@@ -61,8 +67,9 @@ def main() -> int:
     ok = ok[np.argsort(-out["num_steps"][ok], kind="stable")]
     ndev = len(jax.local_devices())
     mesh = device_mesh(None)
+    ec = {} if a.error_control is None else {"lyapunov_error_control": a.error_control}
     lcfg = SweepConfig(transient_periods=0, sample_periods=30, lyapunov_periods=a.lyapunov, rtol=1e-8, atol=1e-10,
-                       max_steps=10**6, stop_on_invalid=True)  # fmt: skip
+                       max_steps=10**6, stop_on_invalid=True, **ec)  # fmt: skip
     pb_np = jax.tree_util.tree_map(np.asarray, pb)
     lyap = sb._lyap_chunk(jax.default_backend())
     pool_per_device = min(DEFAULT_WIDTH, -(-a.n_freq // ndev))
@@ -79,11 +86,11 @@ def main() -> int:
         return jax.tree_util.tree_map(lambda v: v[idx], pb_np), out["samples"][idx, 0], out["t_samples"][idx, 0]
 
     def run(program, groups):
-        lam = np.full(a.n_freq, np.nan)
+        lam, err = np.full(a.n_freq, np.nan), np.full(a.n_freq, np.nan)
         for idx, own in groups:
-            x, _ = program(*args(idx), lcfg, mesh)
-            lam[idx[own]] = np.asarray(x)[own]
-        return lam
+            x, e = program(*args(idx), lcfg, mesh)
+            lam[idx[own]], err[idx[own]] = np.asarray(x)[own], np.asarray(e)[own]
+        return lam, err
 
     rows, programs = {}, {}
     for name, groups in layouts.items():
@@ -93,12 +100,12 @@ def main() -> int:
         programs[name] = lowered.compile()
         t_compile = time.perf_counter() - t - t_lower
         t = time.perf_counter()
-        lam = run(programs[name], groups)
+        lam, err = run(programs[name], groups)
         rows[name] = {"groups": len(groups), "lanes_per_device": int(groups[0][0].size // ndev),
                       "padding_positions": int(sum((~own).sum() for _, own in groups)),
                       "trace_and_lower_s": t_lower, "xla_compile_s": t_compile,
                       "first_call_s": t_lower + t_compile + time.perf_counter() - t, "warm_each_s": [],
-                      "lyapunov": lam}  # fmt: skip
+                      "lyapunov": lam, "lyapunov_stderr": err}  # fmt: skip
     for _ in range(a.reps):
         for name, groups in layouts.items():
             t = time.perf_counter()
@@ -114,12 +121,14 @@ def main() -> int:
         r["speedup_vs_contiguous"] = float(np.median(base["warm_each_s"]) / r["warm_s"])
         d = np.abs(np.asarray(r["lyapunov"])[ok] - base_lam[ok])
         r["max_abs_lyapunov_difference_vs_contiguous"] = float(np.max(d)) if d.size else 0.0
-        r["lyapunov"] = [None if not np.isfinite(v) else float(v) for v in r["lyapunov"]]
+        for k in ("lyapunov", "lyapunov_stderr"):
+            r[k] = [None if not np.isfinite(v) else float(v) for v in r[k]]
         print(f"{name:<18}{r['groups']:>7}{r['padding_positions']:>9}{r['trace_and_lower_s']:>7.2f}s"
               f"{r['xla_compile_s']:>7.2f}s{r['first_call_s']:>11.2f}s{r['warm_s']:>8.2f}s"
               f"{r['speedup_vs_contiguous']:>14.2f}x{r['max_abs_lyapunov_difference_vs_contiguous']:>15.2e}")  # fmt: skip
     res = {"config": {"n_freq": a.n_freq, "transient_periods": 100, "sample_periods": 30, "lyapunov_periods": a.lyapunov,
-                      "rtol": 1e-8, "atol": 1e-10, "stop_on_invalid": True, "reps": a.reps},
+                      "rtol": 1e-8, "atol": 1e-10, "stop_on_invalid": True, "reps": a.reps,
+                      "lyapunov_error_control": lcfg.lyapunov_error_control},
            "devices": ndev, "successful_lanes": int(len(ok)), "pool_lanes_per_device": pool_per_device,
            "library_default_lanes_per_device": sb.LYAPUNOV_GROUP_WIDTH, "layouts": rows, "versions": versions()}  # fmt: skip
     write_result(a.out, res, load_at_start=load0)

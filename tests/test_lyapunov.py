@@ -26,10 +26,17 @@ def duffing(t, y, d):
     return jnp.stack([y[1], -d * y[1] - y[0] - 0.1 * y[0] ** 3 + 0.2 * jnp.cos(1.2 * t)])
 
 
-def test_lorenz_largest_exponent():
+@pytest.mark.parametrize("error_control", ["state", "all"])
+def test_lorenz_largest_exponent(error_control):
+    # the step-size control measuring the state alone (default) or the state and the tangent vector:
+    # both within the known answer's 2 %
     y0s = jnp.array([[1.0, 1.0, 20.0], [-3.0, 2.0, 25.0], [5.0, -5.0, 10.0], [0.5, 0.1, 30.0]])
     f = jax.jit(
-        jax.vmap(lambda y0: largest_lyapunov(lorenz, y0, None, segment=1.0, n_segments=1000, n_transient_segments=20))
+        jax.vmap(
+            lambda y0: largest_lyapunov(
+                lorenz, y0, None, segment=1.0, n_segments=1000, n_transient_segments=20, error_control=error_control
+            )
+        )
     )
     r = f(y0s)
     assert bool(np.all(r.success))
@@ -37,15 +44,30 @@ def test_lorenz_largest_exponent():
     assert abs(lam - 0.9056) / 0.9056 < 0.02, np.asarray(r.exponent)
 
 
+@pytest.mark.parametrize("error_control", ["state", "all"])
 @pytest.mark.parametrize("d", [0.3, 0.1])
-def test_duffing_periodic_orbit_negative(d):
+def test_duffing_periodic_orbit_negative(d, error_control):
     T = 2 * np.pi / 1.2
-    r = jax.jit(lambda y0: largest_lyapunov(duffing, y0, d, segment=T, n_segments=150, n_transient_segments=100))(
-        jnp.array([0.1, 0.0])
-    )
+    r = jax.jit(
+        lambda y0: largest_lyapunov(
+            duffing, y0, d, segment=T, n_segments=150, n_transient_segments=100, error_control=error_control
+        )
+    )(jnp.array([0.1, 0.0]))
     lam = float(r.exponent)
     assert lam < 0
     assert abs(lam - (-d / 2)) / (d / 2) < 0.02, lam
+
+
+def test_error_control_bad_input(paper_params):
+    with pytest.raises(ValueError, match="error_control"):
+        largest_lyapunov(lorenz, jnp.ones(3), None, segment=1.0, n_segments=2, error_control="tangent")
+    from jaxcelt.ensemble import SweepConfig
+
+    with pytest.raises(ValueError, match="lyapunov_error_control"):
+        SweepConfig(lyapunov_error_control="none")
+    # recorded in the dataset's settings (and so its fingerprint) only where a Lyapunov stage runs
+    assert SweepConfig(lyapunov_periods=5).attrs()["lyapunov_error_control"] == "state"
+    assert "lyapunov_error_control" not in SweepConfig().attrs()
 
 
 def test_celt_projection_keeps_manifold(paper_params):

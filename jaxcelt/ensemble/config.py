@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from jaxcelt.ensemble.kernel import kernel_supported
+from jaxcelt.integrate.lyapunov import ERROR_CONTROLS
 from jaxcelt.integrate.solve import DEFAULT_SOLVER
 from jaxcelt.physics.contact.registry import get_contact_law
 
@@ -41,6 +42,9 @@ class SweepConfig:
     t0: float = 0.0
     stop_on_invalid: bool = False
     """end a lane at the first accepted step whose end state is invalid (status 2, later samples inf)"""
+    lyapunov_error_control: str = "state"
+    """what the Lyapunov stage's step-size control measures (`jaxcelt.integrate.lyapunov.ERROR_CONTROLS`):
+    ``"state"`` (default) or ``"all"`` (the state and the tangent vector)"""
     stiffness: str = "off"
     """the lane kernel's stiffness switch (`jaxcelt.ensemble.stiff`): ``"auto"`` steps a lane with
     Rodas4P while its explicit steps are stability-limited (a stone sticking to the base), ``"off"``
@@ -58,6 +62,10 @@ class SweepConfig:
             raise ValueError(f"'stiffness' must be 'auto' or 'off', got {self.stiffness!r}")
         if self.field_dtype not in (None, "float32", "float64"):
             raise ValueError(f"'field_dtype' must be None, 'float32' or 'float64', got {self.field_dtype!r}")
+        if self.lyapunov_error_control not in ERROR_CONTROLS:
+            raise ValueError(
+                f"'lyapunov_error_control' must be one of {ERROR_CONTROLS}, got {self.lyapunov_error_control!r}"
+            )
         if self.dtype not in ("float64", "float32"):
             raise ValueError(f"'dtype' must be 'float64' or 'float32', got {self.dtype!r}")
         for name in ("transient_periods", "sample_periods", "lyapunov_periods", "max_steps"):
@@ -90,6 +98,7 @@ class SweepConfig:
             stop_on_invalid=int(bool(self.stop_on_invalid)),
             dtype=str(self.dtype),
             **({} if self.stiffness == "off" else {"stiffness": str(self.stiffness)}),
+            **({"lyapunov_error_control": str(self.lyapunov_error_control)} if self.lyapunov_periods > 0 else {}),
             **({} if self.field_dtype is None else {"field_dtype": str(self.field_dtype)}),
         )
 

@@ -127,6 +127,21 @@ def _unit_direction(dim: int, dtype) -> Array:
     return d / jnp.linalg.norm(d)
 
 
+ERROR_CONTROLS = ("all", "state")
+"""what the step-size control of a tangent solve measures (`largest_lyapunov`'s ``error_control``)"""
+
+
+def _error_norm(error_control: str, dim: int) -> Callable[[Array], Array]:
+    """The step-size controller's norm of the scaled error of z = (y, dy): diffrax's RMS norm of all of z, or of
+    its first ``dim`` components (the state)."""
+    if error_control not in ERROR_CONTROLS:
+        raise ValueError(f"'error_control' must be one of {ERROR_CONTROLS}, got {error_control!r}")
+    norm = diffrax.PIDController.__dataclass_fields__["norm"].default  # diffrax's default (RMS)
+    if error_control == "all":
+        return norm
+    return lambda e: norm(e[:dim])
+
+
 def largest_lyapunov(
     vector_field: Callable[[Any, Array, Any], Array],
     y0: Array,
@@ -143,6 +158,7 @@ def largest_lyapunov(
     rtol: float = 1e-8,
     atol: float = 1e-10,
     max_steps: int = 100_000,
+    error_control: str = "state",
 ) -> LyapunovResult:
     """Largest Lyapunov exponent of dy/dt = f(t, y, args) from the orbit through ``y0``.
 
@@ -160,8 +176,10 @@ def largest_lyapunov(
             component that does not feed back, e.g. a position). Default all ones.
         project: ``project(y, dy, args) -> dy`` applied before each renormalisation (e.g.
             onto the tangent space of an invariant manifold).
-        solver, rtol, atol, max_steps: per-segment diffrax settings (default Tsit5 + PID);
-            the error control covers both y and dy.
+        solver, rtol, atol, max_steps: per-segment diffrax settings (default Tsit5 + PID).
+        error_control: what the step-size control measures: ``"state"`` (default) the error of y
+            alone, so that the tangent vector takes the steps the state needs (as
+            DynamicalSystems.jl's tangent integrators do by default), or ``"all"``: of y and dy.
 
     Returns:
         `LyapunovResult`. Pure and jittable; vmap over y0/args for batches; forward-mode
@@ -186,7 +204,7 @@ def largest_lyapunov(
 
     term = diffrax.ODETerm(tangent_field)
     solver = solver or diffrax.Tsit5()
-    controller = diffrax.PIDController(rtol=rtol, atol=atol)
+    controller = diffrax.PIDController(rtol=rtol, atol=atol, norm=_error_norm(error_control, dim))
     seg = jnp.asarray(segment, y0.dtype)
     t0 = jnp.asarray(t0, y0.dtype)
 
@@ -245,13 +263,15 @@ def celt_lyapunov(
     rtol: float = 1e-8,
     atol: float = 1e-10,
     max_steps: int = 100_000,
+    error_control: str = "state",
 ) -> LyapunovResult:
     """Largest Lyapunov exponent of the wobblestone [1/s], renormalised once per forcing period.
 
     Segments are T = 2 pi / omega_pi (eq. 17), starting at ``t0``; ``samples`` are the
     stroboscopic states at t0 + k T, k = transient_periods + 1 ... . r_C is excluded from
     the tangent norm and the tangent vector is kept on the contact manifold
-    (`celt_tangent_projection`). ``max_steps`` is per period. Vmappable over params/y0.
+    (`celt_tangent_projection`). ``max_steps`` is per period; ``error_control``: `largest_lyapunov`'s. Vmappable
+    over params/y0.
     """
     T = 2 * jnp.pi / params.omega_pi
     return largest_lyapunov(
@@ -268,4 +288,5 @@ def celt_lyapunov(
         rtol=rtol,
         atol=atol,
         max_steps=max_steps,
+        error_control=error_control,
     )

@@ -36,6 +36,10 @@ class SweepOptions:
             exactly: the samples are solver states).
         lyapunov_periods: > 0 also integrates the tangent dynamics for that many periods after the
             transient (`jaxcelt.integrate.lyapunov.celt_lyapunov`) -> ``lyapunov`` [1/s]; 0: off.
+        lyapunov_error_control: what the step-size control of the tangent solve measures: ``"state"``
+            (default) the state's error alone, ``"all"`` the state's and the tangent vector's
+            (`jaxcelt.integrate.lyapunov.largest_lyapunov`'s ``error_control``). Part of the dataset's
+            fingerprint when ``lyapunov_periods > 0``.
         rtol, atol, max_steps, solver, contact_law, t0: as in `jaxcelt.simulate` (``solver=None``:
             `jaxcelt.integrate.solve.DEFAULT_SOLVER`).
         stop_on_invalid: end each lane at its first invalid state (lift-off, n3 <= 0): status 2,
@@ -80,6 +84,7 @@ class SweepOptions:
     transient_periods: int = 200
     sample_periods: int = 100
     lyapunov_periods: int = 0
+    lyapunov_error_control: str = "state"
     rtol: float = 1e-8
     atol: float = 1e-10
     max_steps: int = 1_000_000
@@ -109,6 +114,7 @@ class SweepOptions:
             transient_periods=int(self.transient_periods),
             sample_periods=int(self.sample_periods),
             lyapunov_periods=int(self.lyapunov_periods),
+            lyapunov_error_control=self.lyapunov_error_control,
             rtol=float(self.rtol),
             atol=float(self.atol),
             max_steps=int(self.max_steps),
