@@ -40,6 +40,7 @@ import diffrax
 import jax
 import jax.numpy as jnp
 import numpy as np
+import optimistix as optx
 
 from jaxcelt import _config  # noqa: F401
 from jaxcelt._diffrax_adapter import solve_to
@@ -131,15 +132,12 @@ ERROR_CONTROLS = ("all", "state")
 """what the step-size control of a tangent solve measures (`largest_lyapunov`'s ``error_control``)"""
 
 
-def _error_norm(error_control: str, dim: int) -> Callable[[Array], Array]:
-    """The step-size controller's norm of the scaled error of z = (y, dy): diffrax's RMS norm of all of z, or of
-    its first ``dim`` components (the state)."""
+def _norm_option(error_control: str, dim: int) -> dict[str, Callable[[Array], Array]]:
+    """The step-size controller's ``norm`` of the scaled error of z = (y, dy): diffrax's own (the RMS norm of all of
+    z: no option) or the RMS norm of its first ``dim`` components (the state)."""
     if error_control not in ERROR_CONTROLS:
         raise ValueError(f"'error_control' must be one of {ERROR_CONTROLS}, got {error_control!r}")
-    norm = diffrax.PIDController.__dataclass_fields__["norm"].default  # diffrax's default (RMS)
-    if error_control == "all":
-        return norm
-    return lambda e: norm(e[:dim])
+    return {} if error_control == "all" else {"norm": lambda e: optx.rms_norm(e[:dim])}
 
 
 def largest_lyapunov(
@@ -204,7 +202,7 @@ def largest_lyapunov(
 
     term = diffrax.ODETerm(tangent_field)
     solver = solver or diffrax.Tsit5()
-    controller = diffrax.PIDController(rtol=rtol, atol=atol, norm=_error_norm(error_control, dim))
+    controller = diffrax.PIDController(rtol=rtol, atol=atol, **_norm_option(error_control, dim))
     seg = jnp.asarray(segment, y0.dtype)
     t0 = jnp.asarray(t0, y0.dtype)
 
