@@ -161,6 +161,13 @@ def _abstract(tree: Any, mesh: Any) -> Any:
     return jax.tree_util.tree_map(lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=spec), tree)
 
 
+def _host_slots(carry: PoolCarry) -> PoolCarry:
+    """``carry`` with the slots' lane states and lane indices copied to the host (a few hundred numbers), enough for
+    `remaining_steps`: computed on the device, its dozen operations were each a program compiled on a first call."""
+    slots = carry.slots._replace(lane=jax.device_get(carry.slots.lane))
+    return carry._replace(slots=slots, lane=np.asarray(carry.lane))
+
+
 def prepare_pool(
     pb: CeltParams,
     y0b: Array,
@@ -229,7 +236,7 @@ def prepare_pool(
         if len(widths) > 1 and np.any(np.asarray(carry.lane) < lanes_per_device):
             # the lanes left: through the narrow drain if they are predicted to need at least
             # drain_min_steps more steps, else on at the full width (the same lanes either way)
-            left = float(jnp.max(remaining_steps(carry, float(cfg.t0))))  # on the device: the slots only
+            left = float(np.max(remaining_steps(_host_slots(carry), float(cfg.t0))))
             if left >= drain_min_steps:
                 if drain_compiled is None:
                     drain_compiled = compile_later(drain_program)
