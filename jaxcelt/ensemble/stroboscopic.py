@@ -308,9 +308,17 @@ def _run_lanes(
     Gd = min(Wd, LYAPUNOV_GROUP_WIDTH)  # the Lyapunov stage's lanes per device (`LYAPUNOV_GROUP_WIDTH`)
     G = Gd * ndev
     lyap_fn = _lyap_chunk(platform)
-    # The pool's programs and the Lyapunov stage's are traced here, one after the other, and
+    # The Lyapunov stage's program and the pool's are traced here, one after the other, and
     # compiled by XLA on worker threads at the same time (XLA releases the GIL while compiling); all
     # are then called as compiled programs. Later chunks of the same shapes find them in JAX's caches.
+    # The stage's goes first: it runs after the pool, but takes longer to trace and compile than the pool
+    # takes to compile and run, so its compilation is what the stage waits for.
+    lyap_compiled = None
+    if cfg.lyapunov_periods > 0 and not compile_only:
+        example = (jax.tree_util.tree_map(lambda x: x[:1].repeat(G, 0), pb_np), np.zeros((G, 13)), np.zeros(G))
+        with gc_paused():
+            lyap_lowered = lyap_fn.lower(*example, static_cfg, mesh)
+        lyap_compiled = compile_later(lyap_lowered.compile)
     if use_kernel:
         leaves, treedef = jax.tree_util.tree_flatten(pb_p)
         p_const = jax.tree_util.tree_unflatten(treedef, [x[0].item() for x in leaves])
@@ -327,12 +335,6 @@ def _run_lanes(
             mesh=mesh, vary=vary, pause_frac=frac, opaque_true=opaque_true, platform=platform,
             drain=(int(drain_factor), int(min_drain_width)), drain_min_steps=drain_min_steps, compile_only=compile_only,
         )  # fmt: skip
-    lyap_compiled = None
-    if cfg.lyapunov_periods > 0 and not compile_only:
-        example = (jax.tree_util.tree_map(lambda x: x[:1].repeat(G, 0), pb_np), np.zeros((G, 13)), np.zeros(G))
-        with gc_paused():
-            lyap_lowered = lyap_fn.lower(*example, static_cfg, mesh)
-        lyap_compiled = compile_later(lyap_lowered.compile)
     if use_kernel:
         out, lane_iters = pool_compiled.result()(*pool_args)
         lane_iters = np.asarray(lane_iters)  # each lane: its block's loop iterations
