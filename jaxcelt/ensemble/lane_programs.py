@@ -57,11 +57,11 @@ def lane_extras(ys: Array, p: CeltParams) -> dict[str, Array]:
     return dict(drift=drift, max_excursion=exc, r_O=r_O)
 
 
-def lane_stepper(cfg: SweepConfig, opaque_true: Array | None = None, rolled_stages: bool = False) -> AbstractLaneStepper:
+def lane_stepper(cfg: SweepConfig, opaque_true: Array | None = None) -> AbstractLaneStepper:
     """The stepper of the sweep's solver (`jaxcelt.ensemble.make_stepper`)."""
     return make_stepper(
         cfg.solver, cfg.contact_law, rtol=cfg.rtol, atol=cfg.atol, max_steps=cfg.max_steps,
-        stop_on_invalid=cfg.stop_on_invalid, opaque_true=opaque_true, rolled_stages=rolled_stages,
+        stop_on_invalid=cfg.stop_on_invalid, opaque_true=opaque_true,
     )  # fmt: skip
 
 
@@ -102,19 +102,19 @@ def pool_start(
     return shard_lanes(run, mesh, 3)(pb, y0b, live)
 
 
-@functools.partial(jax.jit, static_argnames=("cfg", "mesh", "vary", "narrow_to", "rolled_stages"))
+@functools.partial(jax.jit, static_argnames=("cfg", "mesh", "vary", "narrow_to"))
 def pool_advance(
     pb: CeltParams, carry: PoolCarry, pause_frac: Array, transient: Array, until: Array, opaque_true: Array | None,
-    *, cfg: SweepConfig, mesh: Any, vary: tuple[bool, ...], narrow_to: tuple[int, ...], rolled_stages: bool = False,
+    *, cfg: SweepConfig, mesh: Any, vary: tuple[bool, ...], narrow_to: tuple[int, ...],
 ) -> PoolCarry:
     """The pool stepped on (per device, `advance_pool`): at its width until no more than ``until``
     lanes have work left (``narrow_to`` empty), or through the drain's narrower widths
     ``narrow_to`` to the end. ``opaque_true``: a traced True (a jit argument: XLA would fold a
     constant predicate and the fused step's kernel boundaries would vanish), or None: no kernel
-    boundaries. ``rolled_stages``: the step's stages in one loop (`jaxcelt.ensemble.FusedERKStepper`)."""
+    boundaries."""
 
     def run(pb, carry):
-        stepper = lane_stepper(cfg, opaque_true, rolled_stages)
+        stepper = lane_stepper(cfg, opaque_true)
         pv_all, params_of = split_lane_args(pb, vary)
         ts_all = pool_times(pb, transient, cfg, stepper)
         t0 = jnp.asarray(cfg.t0, cfg.dtype)
@@ -161,15 +161,6 @@ def _abstract(tree: Any, mesh: Any) -> Any:
     return jax.tree_util.tree_map(lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=spec), tree)
 
 
-def rolled_pool(platform: str, width: int, lanes_per_device: int) -> bool:
-    """Whether a pool's full-width program rolls its step's stages into one loop (`jaxcelt.ensemble.FusedERKStepper`):
-    a pool without a queue on a CPU (no more lanes than slots: each lane takes one slot for its whole run, as in the
-    main job's sweep) that does not get wide vectors (`jaxcelt._compile_options.is_wide_pool`). Such a pool runs
-    briefly, so its compilation weighs more than its steps: the rolled step compiles the right-hand side once instead
-    of once per stage."""
-    return platform == "cpu" and lanes_per_device <= width and not is_wide_pool(platform, width)
-
-
 def _host_slots(carry: PoolCarry) -> PoolCarry:
     """``carry`` with the slots' lane states and lane indices copied to the host (a few hundred numbers), enough for
     `remaining_steps`: computed on the device, its dozen operations were each a program compiled on a first call."""
@@ -212,13 +203,11 @@ def prepare_pool(
     drain_cfg = pool_config(cfg, platform, widths[-1])  # the drain's program: the law's form of its last width
     cfg = pool_config(cfg, platform, width)
     adv_kw = dict(cfg=cfg, mesh=mesh, vary=vary)
-    rolled = rolled_pool(platform, width, lanes_per_device)
     pause, no_until = jnp.asarray(pause_frac), jnp.asarray(0, jnp.int32)
     with gc_paused():
         start_lowered = pool_start.lower(pb, y0b, live, transient, tols, cfg=cfg, width=width, mesh=mesh, vary=vary)
         carry_spec = _abstract(start_lowered.out_info, mesh)
-        wide_lowered = pool_advance.lower(pb, carry_spec, pause, transient, no_until, opaque_true, narrow_to=(),
-                                          rolled_stages=rolled, **adv_kw)  # fmt: skip
+        wide_lowered = pool_advance.lower(pb, carry_spec, pause, transient, no_until, opaque_true, narrow_to=(), **adv_kw)
     wide_compiled = compile_later(functools.partial(wide_lowered.compile, pool_compiler_options(platform, width)))
     # the first and last programs run once per chunk: compiled for compile time (`jaxcelt._compile_options`)
     start_compiled = compile_later(functools.partial(start_lowered.compile, compiler_options(platform)))

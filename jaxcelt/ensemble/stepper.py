@@ -203,36 +203,6 @@ def _combine(y0: Array, coeffs: Any, ks: list[Array]) -> Array:
     return out
 
 
-def _rolled_stages(
-    stage: Callable, boundary: Callable, tab: Any, y0: Array, k0: Array, dts: Array
-) -> tuple[list[Array], Array, Array, Any]:
-    """The stages of an explicit tableau after the first (k0) as one ``fori_loop`` over i: y_i = ``boundary``(y0 +
-    sum_j a_ij k_j), (f_i, aux_i) = ``stage(c_i, y_i)``, k_i = dt f_i. The sums are `_combine`'s in the same order; a
-    coefficient that `_combine` skips (zero, or j >= i: k_j still zero) adds an exact zero where the stages are
-    finite. Returns the stages as a list, the last stage input, its f and aux."""
-    s = len(tab.a_lower)
-    A = np.zeros((s, s + 1))
-    for i, a in enumerate(tab.a_lower):
-        A[i, : len(a)] = np.asarray(a, dtype=float)
-    A = jnp.asarray(A, dtype=y0.dtype)
-    c = jnp.asarray(np.asarray(tab.c, dtype=float))
-    f_aux = jax.eval_shape(stage, c[0], y0)
-    zeros = jax.tree_util.tree_map(lambda x: jnp.zeros(x.shape, x.dtype), f_aux)
-    K = jnp.zeros((s + 1,) + y0.shape, y0.dtype).at[0].set(k0)
-
-    def body(i, carry):
-        K, _, _ = carry
-        yi = y0
-        for j in range(s):  # k_s (j = s) never enters a stage input
-            yi = yi + A[i, j] * K[j]
-        yi = boundary(yi)
-        fi, aux = stage(c[i], yi)
-        return K.at[i + 1].set(fi * dts), yi, (fi, aux)
-
-    K, yi, (fi, aux) = jax.lax.fori_loop(0, s, body, (K, y0, zeros))
-    return [K[j] for j in range(s + 1)], yi, fi, aux
-
-
 def kernel_boundary(opaque_true: Array) -> Callable[[Array], Array]:
     """x -> x, materialised: a conditional on a predicate XLA cannot see (a runtime True).
 
@@ -280,9 +250,6 @@ class FusedERKStepper(AbstractLaneStepper):
     max_steps: int
     stop_on_invalid: bool
     opaque_true: Array | None = None
-    rolled_stages: bool = eqx.field(static=True, default=False)
-    """the stages in one loop (`_rolled_stages`: the right-hand side compiled once instead of once per stage; a program
-    that compiles faster and steps slower); False: the straight-line step"""
 
     def init(self, t0, y0, ts, p, tols):
         # the controller's first step needs no solver state: the fused step's state is the FSAL
@@ -303,21 +270,14 @@ class FusedERKStepper(AbstractLaneStepper):
         t1, y0, t0 = lane.t1, lane.y, lane.tprev
         dt = lane.tnext - t0
         dts = dt.astype(y0.dtype)  # float32 lanes step in float64 time (`float64_times`); float64: no-op
+        ks = [st.f * dts]
         float64 = y0.dtype == jnp.float64
-
-        def stage(c, yi):
+        for c, a in zip(np.asarray(tab.c, dtype=float).tolist(), tab.a_lower):
+            yi = boundary(_combine(y0, a, ks))
             # float32 lanes: the forcing phase from one period, not from t (`jaxcelt.physics.model.field_time`)
             ti = t0 + c * dt if float64 else field_time(t0, p.omega_pi, y0.dtype, c * dt)
-            return vector_field_and_normal(ti, yi, p, self.law)
-
-        if self.rolled_stages:
-            ks, yi, fi, aux = _rolled_stages(stage, boundary, tab, y0, st.f * dts, dts)
-        else:
-            ks = [st.f * dts]
-            for c, a in zip(np.asarray(tab.c, dtype=float).tolist(), tab.a_lower):
-                yi = boundary(_combine(y0, a, ks))
-                fi, aux = stage(c, yi)
-                ks.append(fi * dts)
+            fi, aux = vector_field_and_normal(ti, yi, p, self.law)
+            ks.append(fi * dts)
         b = np.asarray(tab.b_sol, dtype=float)
         fsal_is_y1 = b[-1] == 0.0 and np.array_equal(np.asarray(tab.a_lower[-1], dtype=float), b[:-1])
         y1 = yi if fsal_is_y1 else _combine(y0, b, ks)
@@ -419,11 +379,10 @@ def make_stepper(
     max_steps: int,
     stop_on_invalid: bool,
     opaque_true: Array | None = None,
-    rolled_stages: bool = False,
 ) -> AbstractLaneStepper:
     """The stepper for ``solver``: `FusedERKStepper` for an explicit FSAL tableau, else
     `DiffraxStepper`. ``rtol``/``atol`` fill an implicit solver's root-finder tolerances (as
-    `simulate` does); the step-size tolerances are the lanes' ``tols``. ``opaque_true``, ``rolled_stages``: see
+    `simulate` does); the step-size tolerances are the lanes' ``tols``. ``opaque_true``: see
     `FusedERKStepper`."""
     law = get_contact_law(contact_law)
     wrapped = MonitoredSolver(solver=_fill_implicit_tols(solver, rtol, atol), law=law)
@@ -440,5 +399,4 @@ def make_stepper(
         max_steps=max_steps,
         stop_on_invalid=stop_on_invalid,
         opaque_true=opaque_true,
-        rolled_stages=rolled_stages,
     )
