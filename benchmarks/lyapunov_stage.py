@@ -21,8 +21,9 @@ program: rounding differs, and a finite-time exponent of a chaotic lane amplifie
     .venv/bin/python benchmarks/lyapunov_stage.py --widths 16 --no-contiguous --out /tmp/stage.json   # one layout
 
 ``--error-control state|all``: what the stage's step-size control measures (`jaxcelt.SweepOptions`'
-``lyapunov_error_control``; default the library's); the per-lane exponents and their standard errors are written
-for comparing two runs.
+``lyapunov_error_control``; default the library's); ``--tangent difference|jvp``: how it forms the tangent vector's
+derivative (``lyapunov_tangent``; default the library's). The per-lane exponents and their standard errors are
+written for comparing two runs.
 """
 
 from __future__ import annotations
@@ -45,6 +46,8 @@ def main() -> int:
     ap.add_argument("--no-contiguous", action="store_true", help="leave out the contiguous layout")
     ap.add_argument("--error-control", default=None, choices=("state", "all"),
                     help="what the stage's step-size control measures (default: the library's)")  # fmt: skip
+    ap.add_argument("--tangent", default=None, choices=("difference", "jvp"),
+                    help="how the stage forms the tangent's derivative (default: the library's)")  # fmt: skip
     ap.add_argument("--out", type=Path, default=Path("docs/bifurcation/lyapunov_stage.json"))
     a = ap.parse_args()
     jax.config.update("jax_num_cpu_devices", os.cpu_count() or 1)
@@ -68,6 +71,7 @@ def main() -> int:
     ndev = len(jax.local_devices())
     mesh = device_mesh(None)
     ec = {} if a.error_control is None else {"lyapunov_error_control": a.error_control}
+    ec |= {} if a.tangent is None else {"lyapunov_tangent": a.tangent}
     lcfg = SweepConfig(transient_periods=0, sample_periods=30, lyapunov_periods=a.lyapunov, rtol=1e-8, atol=1e-10,
                        max_steps=10**6, stop_on_invalid=True, **ec)  # fmt: skip
     pb_np = jax.tree_util.tree_map(np.asarray, pb)
@@ -128,7 +132,7 @@ def main() -> int:
               f"{r['speedup_vs_contiguous']:>14.2f}x{r['max_abs_lyapunov_difference_vs_contiguous']:>15.2e}")  # fmt: skip
     res = {"config": {"n_freq": a.n_freq, "transient_periods": 100, "sample_periods": 30, "lyapunov_periods": a.lyapunov,
                       "rtol": 1e-8, "atol": 1e-10, "stop_on_invalid": True, "reps": a.reps,
-                      "lyapunov_error_control": lcfg.lyapunov_error_control},
+                      "lyapunov_error_control": lcfg.lyapunov_error_control, "lyapunov_tangent": lcfg.lyapunov_tangent},
            "devices": ndev, "successful_lanes": int(len(ok)), "pool_lanes_per_device": pool_per_device,
            "library_default_lanes_per_device": sb.LYAPUNOV_GROUP_WIDTH, "layouts": rows, "versions": versions()}  # fmt: skip
     write_result(a.out, res, load_at_start=load0)

@@ -372,7 +372,7 @@ def part_d(part, args):
         p0 = jc.CeltParams.paper(omega_pi=float(w))
         y0 = jc.initial_state(p0)
         T = 2 * np.pi / w
-        ly = celt_lyapunov(p0, y0, periods=max(horizons), error_control="all")  # as its result file
+        ly = celt_lyapunov(p0, y0, periods=max(horizons), error_control="all", tangent="jvp")  # as its result file
         lg = np.asarray(ly.log_growth)
         part.add(dict(kind="lyapunov", omega_pi=w, exponent=float(ly.exponent), log_growth=lg.tolist(),
                       success=bool(ly.success)),

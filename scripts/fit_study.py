@@ -186,7 +186,7 @@ def chaos_data():
 def _lyap(p, y0, periods, rtol=1e-9):
     from jaxcelt.integrate.lyapunov import celt_lyapunov
 
-    r = celt_lyapunov(p, y0, periods=periods, rtol=rtol, atol=rtol * 1e-2, error_control="all")  # as its result file
+    r = celt_lyapunov(p, y0, periods=periods, rtol=rtol, atol=rtol * 1e-2, error_control="all", tangent="jvp")  # as its result file
     return np.asarray(r.log_growth), bool(r.success)
 
 

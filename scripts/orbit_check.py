@@ -81,7 +81,7 @@ def check(periods: int = 1000, transient_lyap: int = 30) -> dict:
 
     t = time.perf_counter()
     lyap = jc.celt_lyapunov(p, orb.y, periods=periods, transient_periods=transient_lyap, t0=t0, rtol=1e-10, atol=1e-12,
-                           error_control="all")  # as its result file
+                           error_control="all", tangent="jvp")  # as its result file
     lam = float(lyap.exponent)
     t_lyap = time.perf_counter() - t
     lam_orbit = float(orb.floquet_exponent)

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from jaxcelt.ensemble.kernel import kernel_supported
-from jaxcelt.integrate.lyapunov import ERROR_CONTROLS
+from jaxcelt.integrate.lyapunov import ERROR_CONTROLS, TANGENTS
 from jaxcelt.integrate.solve import DEFAULT_SOLVER
 from jaxcelt.physics.contact.registry import get_contact_law
 
@@ -45,6 +45,9 @@ class SweepConfig:
     lyapunov_error_control: str = "state"
     """what the Lyapunov stage's step-size control measures (`jaxcelt.integrate.lyapunov.ERROR_CONTROLS`):
     ``"state"`` (default) or ``"all"`` (the state and the tangent vector)"""
+    lyapunov_tangent: str = "difference"
+    """how the Lyapunov stage forms the tangent vector's derivative (`jaxcelt.integrate.lyapunov.TANGENTS`):
+    ``"difference"`` (default, a forward difference of the field) or ``"jvp"`` (forward-mode differentiation)"""
     stiffness: str = "off"
     """the lane kernel's stiffness switch (`jaxcelt.ensemble.stiff`): ``"auto"`` steps a lane with
     Rodas4P while its explicit steps are stability-limited (a stone sticking to the base), ``"off"``
@@ -66,6 +69,8 @@ class SweepConfig:
             raise ValueError(
                 f"'lyapunov_error_control' must be one of {ERROR_CONTROLS}, got {self.lyapunov_error_control!r}"
             )
+        if self.lyapunov_tangent not in TANGENTS:
+            raise ValueError(f"'lyapunov_tangent' must be one of {TANGENTS}, got {self.lyapunov_tangent!r}")
         if self.dtype not in ("float64", "float32"):
             raise ValueError(f"'dtype' must be 'float64' or 'float32', got {self.dtype!r}")
         for name in ("transient_periods", "sample_periods", "lyapunov_periods", "max_steps"):
@@ -98,7 +103,8 @@ class SweepConfig:
             stop_on_invalid=int(bool(self.stop_on_invalid)),
             dtype=str(self.dtype),
             **({} if self.stiffness == "off" else {"stiffness": str(self.stiffness)}),
-            **({"lyapunov_error_control": str(self.lyapunov_error_control)} if self.lyapunov_periods > 0 else {}),
+            **({"lyapunov_error_control": str(self.lyapunov_error_control), "lyapunov_tangent": str(self.lyapunov_tangent)}
+               if self.lyapunov_periods > 0 else {}),  # fmt: skip
             **({} if self.field_dtype is None else {"field_dtype": str(self.field_dtype)}),
         )
 

@@ -99,6 +99,7 @@ def _lyap_lane(p: CeltParams, y_start: Array, t_start: Array, cfg: SweepConfig) 
         atol=cfg.atol,
         max_steps=cfg.max_steps,  # per period: a bound, not a cost
         error_control=cfg.lyapunov_error_control,
+        tangent=cfg.lyapunov_tangent,
     )
     return lr.exponent, lr.stderr
 

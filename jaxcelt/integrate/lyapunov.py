@@ -1,12 +1,18 @@
 """Largest Lyapunov exponent by tangent dynamics with periodic renormalisation (Benettin et al.).
 
-The augmented system (y, dy) is integrated with the tangent field built by forward-mode
-differentiation of the model's own right-hand side,
+The augmented system (y, dy) is integrated with a tangent field built from the model's own
+right-hand side, so there is no hand-written Jacobian to drift out of step with the physics:
 
     d/dt y  = f(t, y),
-    d/dt dy = J_f(t, y) dy = jax.jvp(f(t, .), (y,), (dy,))[1],
+    d/dt dy = J_f(t, y) dy ~ (f(t, y + h dy) - f(t, y)) / h        (tangent="difference", default)
+    d/dt dy = J_f(t, y) dy = jax.jvp(f(t, .), (y,), (dy,))[1]       (tangent="jvp").
 
-so there is no hand-written Jacobian to drift out of step with the physics. Every
+The difference quotient is the directional derivative of matrix-free Newton-Krylov solvers, with their step
+h = sqrt(eps) sqrt(1 + |y|) / |dy| (M. Pernice & H. F. Walker, NITSOL, SIAM J. Sci. Comput. 19 (1998) 302-318; PETSc's
+MATMFFD_WP), accurate to about sqrt(eps) relative: two evaluations of f side by side cost less than f and its
+forward-mode derivative, and compile to a smaller program. It
+is the tangent of the same discretised flow (with ``error_control="state"`` the steps are the state's in both), so
+the exponents agree far inside their standard errors (docs/internals/sweep-engine.md). Every
 ``segment`` seconds the tangent vector is renormalised to unit length and the log of its
 growth is accumulated; lambda_1 = (sum of log growths) / (elapsed time) [1/s]. One adaptive
 solve per segment (diffeqsolve's steps as a plain while loop, `jaxcelt._diffrax_adapter.solve_to`)
@@ -58,6 +64,8 @@ __all__ = [
     "exponent_stderr",
     "CELT_NORM_MASK",
     "STDERR_BLOCKS",
+    "ERROR_CONTROLS",
+    "TANGENTS",
 ]
 
 # numpy, not jnp: a module-level jnp array would initialise the JAX backend on import
@@ -131,6 +139,38 @@ def _unit_direction(dim: int, dtype) -> Array:
 ERROR_CONTROLS = ("all", "state")
 """what the step-size control of a tangent solve measures (`largest_lyapunov`'s ``error_control``)"""
 
+TANGENTS = ("difference", "jvp")
+"""how the tangent vector's derivative J_f dy is formed (`largest_lyapunov`'s ``tangent``)"""
+
+
+def _tangent_field(
+    vector_field: Callable[[Any, Array, Any], Array], dim: int, tangent: str, weights: Array
+) -> Callable[[Any, Array, Any], Array]:
+    """The field of z = (y, dy): (f(t, y), J_f(t, y) dy) with J_f dy by ``tangent`` (`TANGENTS`): a forward difference
+    with step h = sqrt(eps) sqrt(1 + |y|_w) / |dy| (|.|_w: the ``weights``' norm; h is a numerical choice, held out of
+    derivatives by ``stop_gradient``), or forward-mode differentiation."""
+    if tangent not in TANGENTS:
+        raise ValueError(f"'tangent' must be one of {TANGENTS}, got {tangent!r}")
+    if tangent == "jvp":
+
+        def jvp_field(t, z, a):
+            f, jf = jax.jvp(lambda yy: vector_field(t, yy, a), (z[:dim],), (z[dim:],))
+            return jnp.concatenate([f, jf])
+
+        return jvp_field
+
+    def difference_field(t, z, a):
+        y, dy = z[:dim], z[dim:]
+        root_eps = float(np.sqrt(np.finfo(np.dtype(z.dtype)).eps))
+        size = jnp.sqrt(jnp.sum(dy * dy))
+        h = jax.lax.stop_gradient(
+            root_eps * jnp.sqrt(1 + jnp.sqrt(jnp.sum(weights * y * y))) / jnp.where(size > 0, size, 1.0)
+        )
+        f = jax.vmap(lambda yy: vector_field(t, yy, a))(jnp.stack([y, y + h * dy]))  # both evaluations side by side
+        return jnp.concatenate([f[0], (f[1] - f[0]) / h])
+
+    return difference_field
+
 
 def _norm_option(error_control: str, dim: int) -> dict[str, Callable[[Array], Array]]:
     """The step-size controller's ``norm`` of the scaled error of z = (y, dy): diffrax's own (the RMS norm of all of
@@ -157,6 +197,7 @@ def largest_lyapunov(
     atol: float = 1e-10,
     max_steps: int = 100_000,
     error_control: str = "state",
+    tangent: str = "difference",
 ) -> LyapunovResult:
     """Largest Lyapunov exponent of dy/dt = f(t, y, args) from the orbit through ``y0``.
 
@@ -178,6 +219,9 @@ def largest_lyapunov(
         error_control: what the step-size control measures: ``"state"`` (default) the error of y
             alone, so that the tangent vector takes the steps the state needs (as
             DynamicalSystems.jl's tangent integrators do by default), or ``"all"``: of y and dy.
+        tangent: how J_f dy is formed: ``"difference"`` (default) a forward difference of f along dy (two
+            evaluations of f; accurate to about sqrt(eps) relative), or ``"jvp"``: forward-mode
+            differentiation of f (see the module's docstring).
 
     Returns:
         `LyapunovResult`. Pure and jittable; vmap over y0/args for batches; forward-mode
@@ -196,11 +240,7 @@ def largest_lyapunov(
     dy0 = proj(y0, jnp.asarray(dy0, y0.dtype) * w, args)
     dy0 = dy0 / wnorm(dy0)
 
-    def tangent_field(t, z, a):  # z = (y, dy) as one vector
-        f, jf = jax.jvp(lambda yy: vector_field(t, yy, a), (z[:dim],), (z[dim:],))
-        return jnp.concatenate([f, jf])
-
-    term = diffrax.ODETerm(tangent_field)
+    term = diffrax.ODETerm(_tangent_field(vector_field, dim, tangent, w))  # z = (y, dy) as one vector
     solver = solver or diffrax.Tsit5()
     controller = diffrax.PIDController(rtol=rtol, atol=atol, **_norm_option(error_control, dim))
     seg = jnp.asarray(segment, y0.dtype)
@@ -262,13 +302,14 @@ def celt_lyapunov(
     atol: float = 1e-10,
     max_steps: int = 100_000,
     error_control: str = "state",
+    tangent: str = "difference",
 ) -> LyapunovResult:
     """Largest Lyapunov exponent of the wobblestone [1/s], renormalised once per forcing period.
 
     Segments are T = 2 pi / omega_pi (eq. 17), starting at ``t0``; ``samples`` are the
     stroboscopic states at t0 + k T, k = transient_periods + 1 ... . r_C is excluded from
     the tangent norm and the tangent vector is kept on the contact manifold
-    (`celt_tangent_projection`). ``max_steps`` is per period; ``error_control``: `largest_lyapunov`'s. Vmappable
+    (`celt_tangent_projection`). ``max_steps`` is per period; ``error_control``, ``tangent``: `largest_lyapunov`'s. Vmappable
     over params/y0.
     """
     T = 2 * jnp.pi / params.omega_pi
@@ -287,4 +328,5 @@ def celt_lyapunov(
         atol=atol,
         max_steps=max_steps,
         error_control=error_control,
+        tangent=tangent,
     )

@@ -40,6 +40,10 @@ class SweepOptions:
             (default) the state's error alone, ``"all"`` the state's and the tangent vector's
             (`jaxcelt.integrate.lyapunov.largest_lyapunov`'s ``error_control``). Part of the dataset's
             fingerprint when ``lyapunov_periods > 0``.
+        lyapunov_tangent: how the tangent vector's derivative is formed: ``"difference"`` (default) a
+            forward difference of the field, ``"jvp"`` forward-mode differentiation
+            (`jaxcelt.integrate.lyapunov.largest_lyapunov`'s ``tangent``). Part of the dataset's
+            fingerprint when ``lyapunov_periods > 0``.
         rtol, atol, max_steps, solver, contact_law, t0: as in `jaxcelt.simulate` (``solver=None``:
             `jaxcelt.integrate.solve.DEFAULT_SOLVER`).
         stop_on_invalid: end each lane at its first invalid state (lift-off, n3 <= 0): status 2,
@@ -85,6 +89,7 @@ class SweepOptions:
     sample_periods: int = 100
     lyapunov_periods: int = 0
     lyapunov_error_control: str = "state"
+    lyapunov_tangent: str = "difference"
     rtol: float = 1e-8
     atol: float = 1e-10
     max_steps: int = 1_000_000
@@ -115,6 +120,7 @@ class SweepOptions:
             sample_periods=int(self.sample_periods),
             lyapunov_periods=int(self.lyapunov_periods),
             lyapunov_error_control=self.lyapunov_error_control,
+            lyapunov_tangent=self.lyapunov_tangent,
             rtol=float(self.rtol),
             atol=float(self.atol),
             max_steps=int(self.max_steps),
