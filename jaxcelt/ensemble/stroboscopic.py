@@ -312,8 +312,8 @@ def _run_lanes(
     # The Lyapunov stage's program and the pool's are traced here, one after the other, and
     # compiled by XLA on worker threads at the same time (XLA releases the GIL while compiling); all
     # are then called as compiled programs. Later chunks of the same shapes find them in JAX's caches.
-    # The stage's goes first: it runs after the pool, but takes longer to trace and compile than the pool
-    # takes to compile and run, so its compilation is what the stage waits for.
+    # The stage's goes first: it runs after the pool, but its program is traced while the CPU is still free and
+    # compiles beside the pool's, instead of being traced while the pool's programs compile on every core.
     lyap_compiled = None
     if cfg.lyapunov_periods > 0 and not compile_only:
         example = (jax.tree_util.tree_map(lambda x: x[:1].repeat(G, 0), pb_np), np.zeros((G, 13)), np.zeros(G))

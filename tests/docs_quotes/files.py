@@ -11,6 +11,8 @@ import json
 import statistics
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 
@@ -32,6 +34,50 @@ def _runs_of(pattern: str, commit: str, n: int) -> list[dict]:
         assert d["provenance"]["commit"].startswith(commit) and not d["provenance"]["dirty"], (pattern, commit, i)
         out.append(d)
     return out
+
+
+def _stage_rows(pattern: str, commit: str, config: dict, layout: str = "round-robin 16", n: int = 3) -> list[dict]:
+    """The ``layout`` rows of ``benchmarks/lyapunov_stage.py`` runs ``pattern.format(i=i)`` (i = 1 .. n), each checked
+    to come from a clean checkout of ``commit`` and to have run with the settings ``config``."""
+    rows = []
+    for i in range(1, n + 1):
+        d = _json(pattern.format(i=i))
+        assert d["provenance"]["commit"].startswith(commit) and not d["provenance"]["dirty"], (pattern, i)
+        assert all(d["config"][k] == v for k, v in config.items()), (pattern, i, config)
+        rows.append(d["layouts"][layout])
+    return rows
+
+
+def _warm_each(rows: list[dict]) -> list[float]:
+    """Every warm call of the stage rows, in run order."""
+    return [x for r in rows for x in r["warm_each_s"]]
+
+
+def _exponent_gap(a: dict, b: dict):
+    """|lambda_a - lambda_b| over the lanes both stage rows have, and the same in units of ``a``'s standard errors."""
+
+    def arr(r, k):
+        return np.array([np.nan if x is None else x for x in r[k]])
+
+    la, lb, ea = arr(a, "lyapunov"), arr(b, "lyapunov"), arr(a, "lyapunov_stderr")
+    ok = np.isfinite(la) & np.isfinite(lb)
+    d = np.abs(la - lb)[ok]
+    return d, d / ea[ok]
+
+
+def _sweep_each(runs: list[dict], k: int) -> str:
+    """The sweep's seconds of run ``k`` of ``benchmarks/main_job_compile.py`` result files, one decimal each."""
+    return ", ".join(f"{d['runs'][k]['sweep_s']:.1f}" for d in runs)
+
+
+def _sweep_median(runs: list[dict], k: int) -> float:
+    return statistics.median(d["runs"][k]["sweep_s"] for d in runs)
+
+
+def _same_regimes(runs: list[dict]) -> None:
+    """Asserts that every main-job result file's first run gave the same regimes, lane for lane."""
+    labels = [[r for r in d["runs"][0]["regimes"] if "label" in r] for d in runs]
+    assert all(x == labels[0] for x in labels)
 
 
 def _same_orbit(ds: list[dict]) -> str:
